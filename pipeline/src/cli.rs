@@ -1,0 +1,154 @@
+//! Command-line arguments (clap).
+
+use std::path::PathBuf;
+
+use clap::{ArgGroup, Args, Parser, Subcommand};
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "sedpack",
+    version,
+    about = "Porosity of sediment packings from DEM simulations of non-spherical grains"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Form parameters L, I, S, size D and the 13 form factors of a grain, a mesh, or the
+    /// equancy statistics of a form distribution.
+    Forms(FormsArgs),
+    /// Draw a population of grains and report its statistics.
+    #[command(subcommand)]
+    Sample(SampleCommand),
+    /// Predict porosity with a porosity model.
+    Predict(PredictArgs),
+}
+
+/// Mean and standard deviation of flatness and elongation (§7.1).
+#[derive(Debug, Clone, Args)]
+pub struct DistributionArgs {
+    /// Mean flatness μ_FL, in [0.1, 1].
+    #[arg(long, allow_negative_numbers = true)]
+    pub mu_fl: f64,
+    /// Standard deviation of flatness σ_FL, in [0, 1].
+    #[arg(long, allow_negative_numbers = true)]
+    pub sigma_fl: f64,
+    /// Mean elongation μ_EL, in [0.1, 1].
+    #[arg(long, allow_negative_numbers = true)]
+    pub mu_el: f64,
+    /// Standard deviation of elongation σ_EL, in [0, 1].
+    #[arg(long, allow_negative_numbers = true)]
+    pub sigma_el: f64,
+}
+
+#[derive(Debug, Args)]
+#[command(group(ArgGroup::new("input").required(true).args(["lis", "mesh", "mu_fl"])))]
+pub struct FormsArgs {
+    /// Long, intermediate and short axes (L ≥ I ≥ S > 0, any length unit).
+    #[arg(long, num_args = 3, value_names = ["L", "I", "S"], allow_negative_numbers = true)]
+    pub lis: Option<Vec<f64>>,
+    /// A closed triangle mesh (STL or OBJ); its form is that of its mass-equivalent ellipsoid.
+    #[arg(long)]
+    pub mesh: Option<PathBuf>,
+    /// Mean flatness μ_FL of a form distribution (with --sigma-fl, --mu-el, --sigma-el).
+    #[arg(long, allow_negative_numbers = true, requires_all = ["sigma_fl", "mu_el", "sigma_el"])]
+    pub mu_fl: Option<f64>,
+    #[arg(long, allow_negative_numbers = true, requires = "mu_fl")]
+    pub sigma_fl: Option<f64>,
+    #[arg(long, allow_negative_numbers = true, requires = "mu_fl")]
+    pub mu_el: Option<f64>,
+    #[arg(long, allow_negative_numbers = true, requires = "mu_fl")]
+    pub sigma_el: Option<f64>,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum SampleCommand {
+    /// Draw flatness and elongation from a form distribution (§7.1) and report their statistics.
+    Forms(SampleFormsArgs),
+    /// Draw grain sizes from a sieve curve (§3.2) and report the mass fraction per sieve class.
+    Sizes(SampleSizesArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct SampleFormsArgs {
+    #[command(flatten)]
+    pub distribution: DistributionArgs,
+    /// Number of grains to draw.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    pub count: u64,
+    /// Seed of the random number generator.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
+#[command(group(ArgGroup::new("curve").required(true).args(["case", "sieves"])))]
+pub struct SampleSizesArgs {
+    /// A size case of Table 3: U1, U3, U5, U7, B30, B50, B70.
+    #[arg(long)]
+    pub case: Option<String>,
+    /// A sieve-curve file (YAML or JSON): {sieves: [m, …], fractions: [mass fraction per class]}.
+    #[arg(long)]
+    pub sieves: Option<PathBuf>,
+    /// Number of grains to draw.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    pub count: u64,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
+#[command(group(ArgGroup::new("form").required(true).args(["mu_fl", "fl"])))]
+pub struct PredictArgs {
+    /// paper-U1 | paper-U7 (form mixtures, Eqs. 23–24) or paper-sf-U1 | paper-sf-U7 |
+    /// paper-sf-B50 (single form, Eqs. 17–19).
+    #[arg(long)]
+    pub model: String,
+    #[arg(long, allow_negative_numbers = true, requires_all = ["sigma_fl", "mu_el", "sigma_el"])]
+    pub mu_fl: Option<f64>,
+    #[arg(long, allow_negative_numbers = true, requires = "mu_fl")]
+    pub sigma_fl: Option<f64>,
+    #[arg(long, allow_negative_numbers = true, requires = "mu_fl")]
+    pub mu_el: Option<f64>,
+    #[arg(long, allow_negative_numbers = true, requires = "mu_fl")]
+    pub sigma_el: Option<f64>,
+    /// Flatness FL = S/I of a single form, in (0, 1].
+    #[arg(long, allow_negative_numbers = true, requires = "el")]
+    pub fl: Option<f64>,
+    /// Elongation EL = I/L of a single form, in (0, 1].
+    #[arg(long, allow_negative_numbers = true, requires = "fl")]
+    pub el: Option<f64>,
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl FormsArgs {
+    pub fn distribution(&self) -> Option<DistributionArgs> {
+        distribution(self.mu_fl, self.sigma_fl, self.mu_el, self.sigma_el)
+    }
+}
+
+impl PredictArgs {
+    pub fn distribution(&self) -> Option<DistributionArgs> {
+        distribution(self.mu_fl, self.sigma_fl, self.mu_el, self.sigma_el)
+    }
+}
+
+fn distribution(
+    mu_fl: Option<f64>,
+    sigma_fl: Option<f64>,
+    mu_el: Option<f64>,
+    sigma_el: Option<f64>,
+) -> Option<DistributionArgs> {
+    Some(DistributionArgs { mu_fl: mu_fl?, sigma_fl: sigma_fl?, mu_el: mu_el?, sigma_el: sigma_el? })
+}

@@ -1,0 +1,98 @@
+//! `sedpack forms`: the form of one grain (--lis, --mesh) or of a form distribution.
+
+use anyhow::Context;
+use serde_json::{Map, Value, json};
+use solver::grain::{EquivalentEllipsoid, FormDistribution, FormParameters, TriMesh};
+
+use crate::cli::{DistributionArgs, FormsArgs};
+use crate::output::{Table, number, print_json};
+
+pub fn run(args: &FormsArgs) -> anyhow::Result<()> {
+    let (record, title) = if let Some(lis) = &args.lis {
+        let form = FormParameters::new(lis[0], lis[1], lis[2]).context("--lis")?;
+        (grain_record(&form, form.ellipsoid_volume()), "grain (ellipsoid with full axes L, I, S)".to_string())
+    } else if let Some(path) = &args.mesh {
+        let mesh = TriMesh::from_file(path)?;
+        let props = mesh.mass_properties();
+        let form = EquivalentEllipsoid::of(&props).form().with_context(|| format!("{}", path.display()))?;
+        let mut record = grain_record(&form, props.volume);
+        record.insert("triangles".into(), json!(mesh.triangles().len()));
+        record.insert(
+            "center_of_mass".into(),
+            json!([props.center_of_mass.x, props.center_of_mass.y, props.center_of_mass.z]),
+        );
+        (record, format!("mesh {}", path.display()))
+    } else {
+        let d = args.distribution().expect("clap requires --lis, --mesh or the distribution");
+        (distribution_record(&d)?, "form distribution (§7.1, §7.3)".to_string())
+    };
+    if args.json {
+        return print_json(&record);
+    }
+    println!("{title}");
+    let mut table = Table::default();
+    for (key, value) in &record {
+        match value {
+            Value::Number(n) => table.row(key, number(n.as_f64().unwrap_or(f64::NAN))),
+            Value::Null => table.row(key, "undefined"),
+            Value::Array(items) if key == "notes" => {
+                items.iter().for_each(|n| {
+                    table.row("note", n.as_str().unwrap_or_default());
+                });
+                &mut table
+            }
+            Value::Object(inner) => {
+                for (k, v) in inner {
+                    table.row(format!("{key}.{k}"), number(v.as_f64().unwrap_or(f64::NAN)));
+                }
+                &mut table
+            }
+            other => table.row(key, other.to_string()),
+        };
+    }
+    table.print();
+    Ok(())
+}
+
+/// L, I, S, D, volume, the 13 factors and their inverses (null where undefined, with a note).
+pub fn grain_record(form: &FormParameters, volume: f64) -> Map<String, Value> {
+    let mut record = Map::new();
+    for (key, value) in [("L", form.l), ("I", form.i), ("S", form.s), ("D", form.size()), ("volume", volume)] {
+        record.insert(key.into(), json!(value));
+    }
+    let mut notes = Vec::new();
+    let factors = form.factors();
+    for (prefix, inverse) in [("", false), ("inv_", true)] {
+        for (factor, value, inverse_value) in factors.iter() {
+            let key = format!("{prefix}{}", factor.symbol());
+            match if inverse { inverse_value } else { value } {
+                Ok(v) => record.insert(key, json!(v)),
+                Err(why) => {
+                    notes.push(format!("{key} is {}", why.explain()));
+                    record.insert(key, Value::Null)
+                }
+            };
+        }
+    }
+    record.insert("notes".into(), json!(notes));
+    record
+}
+
+fn distribution_record(d: &DistributionArgs) -> anyhow::Result<Map<String, Value>> {
+    let dist = FormDistribution::new(d.mu_fl, d.sigma_fl, d.mu_el, d.sigma_el)?;
+    let (mu_eq, sigma_eq) = dist.equancy_statistics();
+    let mut record = Map::new();
+    for (key, value) in [
+        ("mu_FL", d.mu_fl),
+        ("sigma_FL", d.sigma_fl),
+        ("mu_EL", d.mu_el),
+        ("sigma_EL", d.sigma_el),
+        ("mu_EQ", mu_eq),
+        ("sigma_EQ", sigma_eq),
+    ] {
+        record.insert(key.into(), json!(value));
+    }
+    // What the grains will actually have after redrawing outside [0.1, 1].
+    record.insert("truncated".into(), serde_json::to_value(dist.truncated_moments())?);
+    Ok(record)
+}

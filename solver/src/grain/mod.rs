@@ -1,0 +1,18 @@
+//! Everything about a single grain and a population of grains: form parameters and factors
+//! (§2, Table 1), meshes and their mass-equivalent ellipsoid (Appendix A), sizes from sieve
+//! curves (§3.2, Table 3), form distributions (§7.1, §7.3) and generated pebble meshes.
+
+pub mod ellipsoid;
+pub mod form;
+pub mod form_distribution;
+pub mod mesh;
+pub mod pebble;
+pub mod size;
+pub mod unit_mesh;
+
+pub use ellipsoid::EquivalentEllipsoid;
+pub use form::{FactorValue, FormError, FormFactor, FormFactors, FormParameters, Undefined};
+pub use form_distribution::{DistributionError, FormDistribution, FormMoments, FormSampler};
+pub use mesh::{MassProperties, MeshDefect, MeshError, TriMesh};
+pub use size::{SieveCurve, SizeError, SizeSampler, TABLE3, TABLE3_SIEVES, Table3Case};
+pub use unit_mesh::UnitMesh;

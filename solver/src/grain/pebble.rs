@@ -1,0 +1,65 @@
+//! Seeded convex "pebble" meshes for users without grain scans: the convex hull of a point
+//! cloud on a lumpy ellipsoid, chipped by a few random planes so that the grain has the flat
+//! facets and edges of fluvial gravel rather than the smoothness of an ellipsoid.
+
+use nalgebra::Vector3;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::form_distribution::FormDistribution;
+use super::mesh::{MeshDefect, TriMesh};
+
+/// Face bound of the paper's simplified meshes (n_F ≤ 300, §5.2.1).
+pub const DEFAULT_MAX_FACES: usize = 300;
+
+/// The Rhine form distribution (Table 2, Fig. 2): pebbles get realistic own forms.
+const RHINE: FormDistribution = FormDistribution { mu_fl: 0.647, sigma_fl: 0.175, mu_el: 0.682, sigma_el: 0.139 };
+
+/// One pebble. A hull of n points in general position has at most 2n − 4 triangles, so
+/// n = (max_faces + 4)/2 points keep the face count within the bound.
+pub fn pebble(seed: u64, max_faces: usize) -> Result<TriMesh, MeshDefect> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let points = (max_faces.max(8) + 4) / 2;
+    let (fl, el) = RHINE.sampler().sample_flatness_elongation(&mut rng);
+    let semi_axes = Vector3::new(1.0, el, el * fl);
+
+    // Smooth lumps: a few broad bumps and dents of the radius.
+    let lumps: Vec<(Vector3<f64>, f64)> =
+        (0..6).map(|_| (random_direction(&mut rng), rng.random_range(-0.12..0.12))).collect();
+    // Chips: planes that cut off caps, leaving flat facets; offsets as fractions of the support.
+    let chips: Vec<(Vector3<f64>, f64)> =
+        (0..rng.random_range(4..9)).map(|_| (random_direction(&mut rng), rng.random_range(0.72..0.92))).collect();
+
+    let cloud: Vec<Vector3<f64>> = (0..points)
+        .map(|_| {
+            let u = random_direction(&mut rng);
+            let lump: f64 = lumps.iter().map(|(c, a)| a * (4.0 * (u.dot(c) - 1.0)).exp()).sum();
+            let mut p = (1.0 + lump + rng.random_range(-0.02..0.02)) * u.component_mul(&semi_axes);
+            for (n, offset) in &chips {
+                let support = n.component_mul(&semi_axes).norm();
+                let excess = p.dot(n) - offset * support;
+                if excess > 0.0 {
+                    p -= excess * n;
+                }
+            }
+            // A tiny jitter keeps chipped points off exact coplanarity, which quickhull dislikes.
+            p + 1e-5 * random_direction(&mut rng)
+        })
+        .collect();
+    TriMesh::convex_hull(&cloud)
+}
+
+/// `count` pebbles from one seed: pebble k uses seed·1,000,003 + k.
+pub fn pebble_library(count: usize, seed: u64, max_faces: usize) -> Result<Vec<TriMesh>, MeshDefect> {
+    (0..count as u64).map(|k| pebble(seed.wrapping_mul(1_000_003).wrapping_add(k), max_faces)).collect()
+}
+
+fn random_direction(rng: &mut ChaCha8Rng) -> Vector3<f64> {
+    loop {
+        let v = Vector3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+        let n = v.norm();
+        if n > 1e-3 && n <= 1.0 {
+            return v / n;
+        }
+    }
+}

@@ -1,0 +1,55 @@
+//! Meshes built by hand for the tests.
+#![allow(dead_code)]
+
+use nalgebra::Vector3;
+
+/// An axis-aligned box with sides (a, b, c) centred at the origin, outward normals, as
+/// (vertices, triangles).
+pub fn box_mesh(a: f64, b: f64, c: f64) -> (Vec<Vector3<f64>>, Vec<[u32; 3]>) {
+    let mut vertices = Vec::new();
+    for k in 0..8 {
+        let s = |bit: u32| if k & (1 << bit) != 0 { 0.5 } else { -0.5 };
+        vertices.push(Vector3::new(s(0) * a, s(1) * b, s(2) * c));
+    }
+    // Vertex k has x from bit 0, y from bit 1, z from bit 2; each face as two CCW triangles.
+    let faces = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let mut triangles = Vec::new();
+    for f in faces {
+        triangles.push([f[0], f[1], f[2]]);
+        triangles.push([f[0], f[2], f[3]]);
+    }
+    (vertices, triangles)
+}
+
+/// A UV tessellation of the ellipsoid with semi-axes (a, b, c): `rings` latitude bands and
+/// `2·rings` meridians, vertices on the surface.
+pub fn ellipsoid_mesh(a: f64, b: f64, c: f64, rings: usize) -> (Vec<Vector3<f64>>, Vec<[u32; 3]>) {
+    let sectors = 2 * rings;
+    let mut vertices = vec![Vector3::new(0.0, 0.0, c)];
+    for r in 1..rings {
+        let theta = std::f64::consts::PI * r as f64 / rings as f64;
+        for s in 0..sectors {
+            let phi = 2.0 * std::f64::consts::PI * s as f64 / sectors as f64;
+            vertices.push(Vector3::new(a * theta.sin() * phi.cos(), b * theta.sin() * phi.sin(), c * theta.cos()));
+        }
+    }
+    vertices.push(Vector3::new(0.0, 0.0, -c));
+    let south = (vertices.len() - 1) as u32;
+    let at = |r: usize, s: usize| (1 + (r - 1) * sectors + s % sectors) as u32;
+    let mut triangles = Vec::new();
+    for s in 0..sectors {
+        triangles.push([0, at(1, s), at(1, s + 1)]);
+        triangles.push([south, at(rings - 1, s + 1), at(rings - 1, s)]);
+    }
+    for r in 1..rings - 1 {
+        for s in 0..sectors {
+            triangles.push([at(r, s), at(r + 1, s), at(r + 1, s + 1)]);
+            triangles.push([at(r, s), at(r + 1, s + 1), at(r, s + 1)]);
+        }
+    }
+    (vertices, triangles)
+}
+
+pub fn rhine_mesh_path(k: usize) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("meshes/rhine_scan_{k}.obj"))
+}
