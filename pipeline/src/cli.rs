@@ -25,6 +25,115 @@ pub enum Command {
     Sample(SampleCommand),
     /// Predict porosity with a porosity model.
     Predict(PredictArgs),
+    /// Simulate one packing from a job file and evaluate its porosity.
+    Pack(PackArgs),
+    /// Evaluate the porosity (§4.4) of a packing of spheres given as x,y,z,r rows.
+    Porosity(PorosityArgs),
+    /// Submit a campaign to the database and run its pending jobs.
+    Run(RunArgs),
+    /// Finish a campaign after an interruption: jobs of dead runners are run again.
+    Resume(ResumeArgs),
+    /// Jobs per state, failures, time spent and left.
+    Status(StatusArgs),
+    /// One CSV row per job: parameters, porosity and grain statistics.
+    Export(ExportArgs),
+}
+
+/// Default database file, in the current folder.
+const DEFAULT_DB: &str = "sedpack.db";
+
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// A campaign file (YAML): a job template plus `grid:` and `seeds:`.
+    pub campaign: PathBuf,
+    #[arg(long, default_value = DEFAULT_DB)]
+    pub db: PathBuf,
+    /// Packings run at the same time (default: the number of cores); the cores are divided
+    /// among them.
+    #[arg(long)]
+    pub workers: Option<usize>,
+    /// Return failed jobs to pending and try them again.
+    #[arg(long)]
+    pub retry_failed: bool,
+    /// Wall-clock seconds between checkpoints of a running packing.
+    #[arg(long, default_value_t = 300.0)]
+    pub checkpoint_interval: f64,
+    /// No progress bars.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct ResumeArgs {
+    /// The campaign's name.
+    pub name: String,
+    #[arg(long, default_value = DEFAULT_DB)]
+    pub db: PathBuf,
+    #[arg(long)]
+    pub workers: Option<usize>,
+    #[arg(long, default_value_t = 300.0)]
+    pub checkpoint_interval: f64,
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct StatusArgs {
+    /// A campaign's name (default: every campaign in the database).
+    pub name: Option<String>,
+    #[arg(long, default_value = DEFAULT_DB)]
+    pub db: PathBuf,
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ExportFormat {
+    Csv,
+}
+
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    pub name: String,
+    #[arg(long, default_value = DEFAULT_DB)]
+    pub db: PathBuf,
+    #[arg(long, value_enum)]
+    pub format: ExportFormat,
+    /// Output file (default: standard output).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct PackArgs {
+    /// A job file (YAML): a campaign without `grid:`; every key has the paper's default.
+    pub job: PathBuf,
+    /// Output folder (default: the job's name).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Print result.json to standard output instead of a table (no progress display).
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct PorosityArgs {
+    /// CSV with a header naming columns x, y, z, r (m), one sphere per row.
+    pub file: PathBuf,
+    /// Side of the horizontally periodic square box (m).
+    #[arg(long, allow_negative_numbers = true)]
+    pub width: f64,
+    /// Slice height h_p (m).
+    #[arg(long, default_value_t = 1e-3, allow_negative_numbers = true)]
+    pub slice: f64,
+    /// Height cut away above the floor and below the surface (m).
+    #[arg(long, allow_negative_numbers = true)]
+    pub trim: f64,
+    /// Porosity defining the free surface.
+    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
+    pub cutoff: f64,
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Mean and standard deviation of flatness and elongation (§7.1).

@@ -1,9 +1,13 @@
 //! The sedpack pipeline: the command line, campaign files and the runner. This is the only
 //! crate that knows the solver, the store and the analysis together.
 
+pub mod campaign;
 pub mod cli;
 pub mod commands;
 pub mod output;
+pub mod runner;
+pub mod spec;
+pub mod vtk;
 
 use cli::{Cli, Command, SampleCommand};
 
@@ -13,5 +17,11 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Sample(SampleCommand::Forms(args)) => commands::sample::forms(&args),
         Command::Sample(SampleCommand::Sizes(args)) => commands::sample::sizes(&args),
         Command::Predict(args) => commands::predict::run(&args),
+        Command::Pack(args) => commands::pack::run(&args),
+        Command::Porosity(args) => commands::porosity::run(&args),
+        Command::Run(args) => commands::campaign::run(&args),
+        Command::Resume(args) => commands::campaign::resume(&args),
+        Command::Status(args) => commands::campaign::status(&args),
+        Command::Export(args) => commands::campaign::export(&args),
     }
 }

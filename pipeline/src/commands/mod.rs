@@ -1,5 +1,8 @@
 //! One module per command of the command line.
 
+pub mod campaign;
 pub mod forms;
+pub mod pack;
+pub mod porosity;
 pub mod predict;
 pub mod sample;

@@ -1,6 +1,6 @@
 //! Form parameters L ≥ I ≥ S, the grain size D (Eq. 1) and the 13 form factors of Table 1.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 /// Relative tolerance under which two axes count as equal when a form factor divides by their
@@ -17,7 +17,7 @@ pub enum FormError {
 
 /// The long, intermediate and short axes of a grain (full axes of its mass-equivalent ellipsoid,
 /// Appendix A), in metres or in any consistent unit.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct FormParameters {
     #[serde(rename = "L")]
     pub l: f64,

@@ -3,7 +3,7 @@
 
 use rand::Rng;
 use rand_distr::{Distribution, Normal};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::form::FormParameters;
@@ -27,7 +27,7 @@ pub enum DistributionError {
 
 /// Independent normal distributions of flatness FL and elongation EL (nominal parameters, the
 /// hatted μ̂, σ̂ of §7.1).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct FormDistribution {
     pub mu_fl: f64,
     pub sigma_fl: f64,

@@ -2,7 +2,7 @@
 //! weights with Eqs. 8–9, sampled on a logarithmic size scale so that no grain leaves its class.
 
 use rand::{Rng, RngExt};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 /// Sieve edges of the laboratory experiments (Table 3), in metres.
@@ -102,7 +102,7 @@ pub enum SizeError {
 }
 
 /// A sieve curve: sieve edges s_0 < s_1 < … < s_n (m) and the mass fraction of each class.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SieveCurve {
     sieves: Vec<f64>,
     fractions: Vec<f64>,

@@ -1,0 +1,351 @@
+//! The report's figures as SVG strings, drawn with plotters' SVG backend. Without the `ttf`
+//! feature plotters lays text out with a fixed-width estimate and the SVG backend writes it as
+//! `<text>` elements with a generic font family, so labels need no font files and the browser
+//! renders them with whatever sans-serif font it has.
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use thiserror::Error;
+
+use crate::correlation::CorrelationMatrix;
+use crate::form_factors::symbol;
+use crate::record::ProfilePoint;
+
+#[derive(Debug, Error, PartialEq)]
+#[error("drawing the {figure}: {message}")]
+pub struct PlotError {
+    pub figure: &'static str,
+    pub message: String,
+}
+
+type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+type Drawn = Result<(), DrawingAreaErrorKind<std::io::Error>>;
+
+const FONT: &str = "sans-serif";
+const ORANGE: RGBColor = RGBColor(230, 120, 20);
+const STEEL: RGBColor = RGBColor(40, 90, 170);
+
+/// Renders one figure into an SVG document string.
+fn render(figure: &'static str, size: (u32, u32), draw: impl FnOnce(&Area) -> Drawn) -> Result<String, PlotError> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        let result = root.fill(&WHITE).and_then(|_| draw(&root)).and_then(|_| root.present());
+        result.map_err(|e| PlotError { figure, message: e.to_string() })?;
+    }
+    Ok(svg)
+}
+
+/// [min, max] of finite values widened by 5 % (or ±0.5 % of the value for a single value),
+/// so points do not sit on the frame.
+fn padded_range(values: impl IntoIterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values
+        .into_iter()
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+    if !lo.is_finite() {
+        return (0.0, 1.0);
+    }
+    let pad = if hi > lo { 0.05 * (hi - lo) } else { 0.005 * lo.abs().max(1e-3) };
+    (lo - pad, hi + pad)
+}
+
+/// Decimals that tell ticks apart on an axis spanning `range`: one more than the range's
+/// leading digit needs.
+fn decimals(range: (f64, f64)) -> usize {
+    let span = (range.1 - range.0).abs();
+    if span > 0.0 { (1 - span.log10().floor() as i32).max(0) as usize } else { 3 }
+}
+
+/// One packing's number-based mean and std of elongation and flatness.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ZinggPacking {
+    pub mean_el: f64,
+    pub std_el: f64,
+    pub mean_fl: f64,
+    pub std_fl: f64,
+}
+
+/// Zingg diagram like Fig. 11: EL on x, FL on y, the class boundaries at 2/3, each packing's
+/// mean as a point and its standard deviations as the semi-axes of an ellipse.
+pub fn zingg_diagram(packings: &[ZinggPacking]) -> Result<String, PlotError> {
+    render("Zingg diagram", (620, 600), |root| {
+        // The legend gets its own strip below the chart: inside, it would hide packings.
+        let (upper, lower) = root.split_vertically(560);
+        let mut chart = ChartBuilder::on(&upper)
+            .caption("Zingg diagram of the packings", (FONT, 20))
+            .margin(15)
+            .x_label_area_size(50)
+            .y_label_area_size(60)
+            .build_cartesian_2d(0f64..1f64, 0f64..1f64)?;
+        chart
+            .configure_mesh()
+            .x_desc("elongation EL = I/L (–)")
+            .y_desc("flatness FL = S/I (–)")
+            .label_style((FONT, 13))
+            .axis_desc_style((FONT, 15))
+            .x_labels(6)
+            .y_labels(6)
+            .light_line_style(WHITE)
+            .draw()?;
+        let boundary = BLACK.mix(0.6).stroke_width(1);
+        chart.draw_series(DashedLineSeries::new([(2.0 / 3.0, 0.0), (2.0 / 3.0, 1.0)], 6, 4, boundary))?;
+        chart.draw_series(DashedLineSeries::new([(0.0, 2.0 / 3.0), (1.0, 2.0 / 3.0)], 6, 4, boundary))?;
+        let class_style =
+            TextStyle::from((FONT, 15).into_font()).color(&BLACK).pos(Pos::new(HPos::Center, VPos::Center));
+        for (name, at) in [
+            ("rod", (1.0 / 3.0, 0.97)),
+            ("equant", (5.0 / 6.0, 0.97)),
+            ("blade", (1.0 / 3.0, 0.03)),
+            ("disk", (5.0 / 6.0, 0.03)),
+        ] {
+            chart.draw_series(std::iter::once(Text::new(name, at, class_style.clone())))?;
+        }
+        let ellipse = |p: &ZinggPacking| -> Vec<(f64, f64)> {
+            (0..=48)
+                .map(|k| {
+                    let t = std::f64::consts::TAU * k as f64 / 48.0;
+                    (p.mean_el + p.std_el * t.cos(), p.mean_fl + p.std_fl * t.sin())
+                })
+                .collect()
+        };
+        chart.draw_series(packings.iter().map(|p| PathElement::new(ellipse(p), STEEL.mix(0.7).stroke_width(1))))?;
+        chart.draw_series(packings.iter().map(|p| Circle::new((p.mean_el, p.mean_fl), 4, ORANGE.filled())))?;
+        let left = TextStyle::from((FONT, 13).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
+        lower.draw(&Circle::new((90, 18), 4, ORANGE.filled()))?;
+        lower.draw(&Text::new("packing mean (μ_EL, μ_FL)", (100, 18), left.clone()))?;
+        lower.draw(&Circle::new((330, 18), 7, STEEL.stroke_width(1)))?;
+        lower.draw(&Text::new("standard deviations as semi-axes", (343, 18), left))?;
+        Ok(())
+    })
+}
+
+/// Points and, optionally, a straight line with its legend (Fig. 8: porosity against the
+/// primary feature with the implied linear model).
+pub struct ScatterPlot<'a> {
+    pub title: &'a str,
+    pub x_label: &'a str,
+    pub y_label: &'a str,
+    pub points: &'a [(f64, f64)],
+    /// (slope, intercept, legend) of the line.
+    pub line: Option<(f64, f64, String)>,
+}
+
+pub fn scatter(plot: &ScatterPlot) -> Result<String, PlotError> {
+    render("scatter plot", (640, 480), |root| {
+        let x = padded_range(plot.points.iter().map(|p| p.0));
+        let y = padded_range(plot.points.iter().map(|p| p.1));
+        let mut chart = ChartBuilder::on(root)
+            .caption(plot.title, (FONT, 19))
+            .margin(15)
+            .x_label_area_size(50)
+            .y_label_area_size(70)
+            .build_cartesian_2d(x.0..x.1, y.0..y.1)?;
+        chart
+            .configure_mesh()
+            .x_desc(plot.x_label)
+            .y_desc(plot.y_label)
+            .label_style((FONT, 13))
+            .axis_desc_style((FONT, 15))
+            .x_label_formatter(&|v| format!("{v:.*}", decimals(x)))
+            .y_label_formatter(&|v| format!("{v:.*}", decimals(y)))
+            .light_line_style(WHITE)
+            .draw()?;
+        chart
+            .draw_series(plot.points.iter().map(|&p| Circle::new(p, 4, STEEL.filled())))?
+            .label("packings")
+            .legend(|(x, y)| Circle::new((x + 7, y), 4, STEEL.filled()));
+        if let Some((slope, intercept, legend)) = &plot.line {
+            let line = [(x.0, intercept + slope * x.0), (x.1, intercept + slope * x.1)];
+            chart
+                .draw_series(LineSeries::new(line, RED.stroke_width(2)))?
+                .label(legend.as_str())
+                .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], RED.stroke_width(2)));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .label_font((FONT, 13))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK.mix(0.4))
+            .draw()
+    })
+}
+
+/// Predicted against observed porosity with the 1:1 line (Figs. 9 and 12): the model fitted on
+/// all rows, and each row's held-out cross-validation prediction.
+pub fn predicted_vs_observed(
+    title: &str,
+    observed: &[f64],
+    fitted: &[f64],
+    held_out: &[f64],
+) -> Result<String, PlotError> {
+    render("predicted-versus-observed plot", (560, 540), |root| {
+        let (lo, hi) = padded_range(observed.iter().chain(fitted).chain(held_out).copied());
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, (FONT, 18))
+            .margin(15)
+            .x_label_area_size(50)
+            .y_label_area_size(70)
+            .build_cartesian_2d(lo..hi, lo..hi)?;
+        chart
+            .configure_mesh()
+            .x_desc("observed porosity n (–)")
+            .y_desc("predicted porosity n (–)")
+            .label_style((FONT, 13))
+            .axis_desc_style((FONT, 15))
+            .x_label_formatter(&|v| format!("{v:.*}", decimals((lo, hi))))
+            .y_label_formatter(&|v| format!("{v:.*}", decimals((lo, hi))))
+            .light_line_style(WHITE)
+            .draw()?;
+        chart
+            .draw_series(LineSeries::new([(lo, lo), (hi, hi)], BLACK.stroke_width(1)))?
+            .label("perfect agreement")
+            .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLACK.stroke_width(1)));
+        chart
+            .draw_series(observed.iter().zip(held_out).map(|(&o, &p)| Circle::new((o, p), 4, RED.stroke_width(1))))?
+            .label("held-out (cross-validation)")
+            .legend(|(x, y)| Circle::new((x + 7, y), 4, RED.stroke_width(1)));
+        chart
+            .draw_series(observed.iter().zip(fitted).map(|(&o, &p)| Circle::new((o, p), 3, STEEL.filled())))?
+            .label("fitted on all packings")
+            .legend(|(x, y)| Circle::new((x + 7, y), 3, STEEL.filled()));
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .label_font((FONT, 13))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK.mix(0.4))
+            .draw()
+    })
+}
+
+/// Diverging colour for r ∈ [−1, 1]: blue for negative, white at 0, red for positive.
+fn correlation_colour(r: f64) -> RGBColor {
+    let t = r.clamp(-1.0, 1.0).abs();
+    let mix = |full: u8| (255.0 + (full as f64 - 255.0) * t).round() as u8;
+    if r >= 0.0 { RGBColor(mix(200), mix(40), mix(40)) } else { RGBColor(mix(40), mix(80), mix(200)) }
+}
+
+/// The correlation matrix as a heat map with the value of r in each cell (Fig. 3).
+pub fn heat_map(title: &str, matrix: &CorrelationMatrix) -> Result<String, PlotError> {
+    const CELL: i32 = 50;
+    const LEFT: i32 = 110;
+    const TOP: i32 = 90;
+    let n = matrix.features.len() as i32;
+    let size = ((LEFT + n * CELL + 90) as u32, (TOP + n * CELL + 20) as u32);
+    render("correlation matrix", size, |root| {
+        let centred = |px: i32| TextStyle::from((FONT, px).into_font()).pos(Pos::new(HPos::Center, VPos::Center));
+        root.draw(&Text::new(title.to_string(), (size.0 as i32 / 2, 22), centred(19)))?;
+        let labels: Vec<String> = matrix.features.iter().map(|f| symbol(f)).collect();
+        for (k, label) in labels.iter().enumerate() {
+            let k = k as i32;
+            let right = TextStyle::from((FONT, 13).into_font()).pos(Pos::new(HPos::Right, VPos::Center));
+            root.draw(&Text::new(label.clone(), (LEFT - 8, TOP + k * CELL + CELL / 2), right))?;
+            let up = TextStyle::from((FONT, 13).into_font())
+                .pos(Pos::new(HPos::Left, VPos::Center))
+                .transform(FontTransform::Rotate270);
+            root.draw(&Text::new(label.clone(), (LEFT + k * CELL + CELL / 2, TOP - 8), up))?;
+        }
+        for (i, row) in matrix.r.iter().enumerate() {
+            for (j, r) in row.iter().enumerate() {
+                let (x, y) = (LEFT + j as i32 * CELL, TOP + i as i32 * CELL);
+                let fill = r.map_or(RGBColor(220, 220, 220), correlation_colour);
+                root.draw(&Rectangle::new([(x, y), (x + CELL, y + CELL)], fill.filled()))?;
+                root.draw(&Rectangle::new([(x, y), (x + CELL, y + CELL)], WHITE.stroke_width(1)))?;
+                let text = r.map_or("–".to_string(), |r| format!("{r:.2}"));
+                let ink = if r.is_some_and(|r| r.abs() > 0.6) { WHITE } else { BLACK };
+                root.draw(&Text::new(text, (x + CELL / 2, y + CELL / 2), centred(12).color(&ink)))?;
+            }
+        }
+        // Colour bar from r = 1 (top) to r = −1 (bottom).
+        let bar_x = LEFT + n * CELL + 25;
+        let bar_h = n * CELL;
+        for step in 0..bar_h {
+            let r = 1.0 - 2.0 * step as f64 / bar_h as f64;
+            root.draw(&Rectangle::new(
+                [(bar_x, TOP + step), (bar_x + 16, TOP + step + 1)],
+                correlation_colour(r).filled(),
+            ))?;
+        }
+        let left = TextStyle::from((FONT, 12).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
+        for (r, at) in [("1", 0), ("0", bar_h / 2), ("−1", bar_h)] {
+            root.draw(&Text::new(r.to_string(), (bar_x + 21, TOP + at), left.clone()))?;
+        }
+        root.draw(&Text::new("r".to_string(), (bar_x + 8, TOP - 12), centred(14)))?;
+        Ok(())
+    })
+}
+
+/// Porosity profiles n(z) of the packings, height upwards as in a bed.
+pub fn profiles(profiles: &[(String, Vec<ProfilePoint>)]) -> Result<String, PlotError> {
+    render("porosity profiles", (640, 520), |root| {
+        let top = padded_range(profiles.iter().flat_map(|(_, p)| p.iter().map(|q| q.z))).1.max(1e-3);
+        let mut chart = ChartBuilder::on(root)
+            .caption("Porosity profiles n(z)", (FONT, 19))
+            .margin(15)
+            .x_label_area_size(50)
+            .y_label_area_size(70)
+            .build_cartesian_2d(0f64..1f64, 0f64..top)?;
+        chart
+            .configure_mesh()
+            .x_desc("slice porosity n (–)")
+            .y_desc("height z (m)")
+            .label_style((FONT, 13))
+            .axis_desc_style((FONT, 15))
+            .y_label_formatter(&|v| format!("{v:.*}", decimals((0.0, top))))
+            .light_line_style(WHITE)
+            .draw()?;
+        // A legend for a handful of packings helps; for a campaign it would hide the plot.
+        let legend = profiles.len() <= 8;
+        for (k, (label, points)) in profiles.iter().enumerate() {
+            let colour = Palette99::pick(k).to_rgba();
+            let series =
+                chart.draw_series(LineSeries::new(points.iter().map(|p| (p.n, p.z)), colour.stroke_width(1)))?;
+            if legend {
+                series
+                    .label(label.as_str())
+                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], colour.stroke_width(2)));
+            }
+        }
+        if legend {
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::UpperLeft)
+                .label_font((FONT, 12))
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK.mix(0.4))
+                .draw()?;
+        }
+        Ok(())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_are_padded_and_survive_degenerate_data() {
+        assert_eq!(padded_range([1.0, 3.0]), (0.9, 3.1));
+        let (lo, hi) = padded_range([0.3, 0.3]);
+        assert!(lo < 0.3 && hi > 0.3);
+        assert_eq!(padded_range([f64::NAN]), (0.0, 1.0));
+    }
+
+    #[test]
+    fn tick_decimals_follow_the_span() {
+        assert_eq!(decimals((1.3, 5.2)), 1);
+        assert_eq!(decimals((0.34, 0.47)), 2);
+        assert_eq!(decimals((0.0, 0.03)), 3);
+        assert_eq!(decimals((100.0, 900.0)), 0);
+    }
+
+    #[test]
+    fn correlation_colours_run_blue_white_red() {
+        assert_eq!(correlation_colour(0.0), RGBColor(255, 255, 255));
+        assert_eq!(correlation_colour(1.0), RGBColor(200, 40, 40));
+        assert_eq!(correlation_colour(-1.0), RGBColor(40, 80, 200));
+    }
+}

@@ -1,0 +1,48 @@
+//! What the analysis reads: one plain record per finished job and a campaign summary. The
+//! pipeline maps store rows into these; the analysis never sees solver or SQLite types.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+/// One slice of a porosity profile.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ProfilePoint {
+    /// Slice centre, m.
+    pub z: f64,
+    /// Porosity of the slice.
+    pub n: f64,
+}
+
+/// A finished packing job.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct JobRecord {
+    pub job_id: String,
+    /// Bulk porosity (§4.4).
+    pub porosity: f64,
+    pub profile: Vec<ProfilePoint>,
+    /// Grid keys (dotted names, e.g. "grains.form.mu_fl") and seed → value.
+    pub parameters: BTreeMap<String, serde_json::Value>,
+    /// "FL", "inv_FL", …, "WFI", "inv_WFI" → (number-based mean, std) over the packing's grains.
+    pub grain_statistics: BTreeMap<String, (f64, f64)>,
+    /// Measured porosity and its standard deviation, when the campaign gives one.
+    pub experiment: Option<(f64, f64)>,
+}
+
+/// The campaign as a whole, for the report header.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CampaignSummary {
+    pub name: String,
+    pub pending: usize,
+    pub running: usize,
+    pub done: usize,
+    pub failed: usize,
+    /// Runtimes of the finished jobs added up, s.
+    pub total_runtime: f64,
+}
+
+impl CampaignSummary {
+    pub fn jobs(&self) -> usize {
+        self.pending + self.running + self.done + self.failed
+    }
+}

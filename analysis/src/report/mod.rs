@@ -1,0 +1,672 @@
+//! The campaign report: report.md, a self-contained report.html (SVG inlined, no external
+//! resources), figures/*.svg for the Markdown, dataset.csv and models/*.json. The content
+//! follows the paper: campaign and packings (Fig. 11, Table 6), feature ranking and primary
+//! feature (Fig. 8), form-factor correlations (Fig. 3), pair and set models (Tables 9, 10),
+//! predicted against observed (Figs. 9, 12) and porosity profiles.
+
+mod document;
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+use thiserror::Error;
+
+use crate::correlation::correlation_matrix;
+use crate::dataset::{Dataset, DatasetError, FeatureKind};
+use crate::form_factors::{FACTORS, symbol};
+use crate::model::LinearModel;
+use crate::plots::{self, PlotError, ScatterPlot, ZinggPacking};
+use crate::record::{CampaignSummary, JobRecord};
+use crate::selection::{Candidate, Selection, SelectionOptions, select_models, set_label};
+use document::Block;
+
+#[derive(Debug, Error)]
+pub enum ReportError {
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error(transparent)]
+    Dataset(#[from] DatasetError),
+    #[error(transparent)]
+    Plot(#[from] PlotError),
+}
+
+/// The files a report consists of.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReportFiles {
+    pub markdown: PathBuf,
+    pub html: PathBuf,
+    pub dataset: PathBuf,
+    pub figures: Vec<PathBuf>,
+    pub models: Vec<PathBuf>,
+}
+
+/// Analyses the finished jobs of a campaign and writes the report into `out_dir`.
+pub fn write_report(
+    summary: &CampaignSummary,
+    records: &[JobRecord],
+    options: &SelectionOptions,
+    out_dir: &Path,
+) -> Result<ReportFiles, ReportError> {
+    let dataset = match Dataset::from_records(records) {
+        Ok(d) => Some(d),
+        Err(DatasetError::NoRecords) => None,
+        Err(e) => return Err(e.into()),
+    };
+    let selection = dataset.as_ref().map(|d| select_models(d, &summary.name, options));
+
+    let mut blocks = Vec::new();
+    campaign_section(&mut blocks, summary, records, dataset.as_ref());
+    packings_section(&mut blocks, records)?;
+    experiment_section(&mut blocks, records);
+    match (&dataset, &selection) {
+        (Some(d), Some(Ok(s))) => {
+            dataset_section(&mut blocks, d);
+            ranking_section(&mut blocks, d, s)?;
+            correlation_section(&mut blocks, d)?;
+            filter_section(&mut blocks, s);
+            pairs_section(&mut blocks, s);
+            sets_section(&mut blocks, d, s)?;
+        }
+        (Some(d), Some(Err(e))) => {
+            dataset_section(&mut blocks, d);
+            blocks.push(Block::Heading("Models".into()));
+            blocks.push(Block::Paragraph(format!("No model could be built: {e}.")));
+        }
+        _ => blocks
+            .push(Block::Paragraph("The campaign has no finished job yet, so there is nothing to analyse.".into())),
+    }
+    method_section(&mut blocks, options, dataset.as_ref());
+
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| ReportError::Io { path, source }
+    };
+    let figures_dir = out_dir.join("figures");
+    let models_dir = out_dir.join("models");
+    for dir in [out_dir, &figures_dir, &models_dir] {
+        std::fs::create_dir_all(dir).map_err(io(dir))?;
+    }
+    let write = |path: PathBuf, text: &str| std::fs::write(&path, text).map_err(io(&path)).map(|_| path);
+
+    let mut figures = Vec::new();
+    for block in &blocks {
+        if let Block::Figure { file, svg, .. } = block {
+            figures.push(write(figures_dir.join(format!("{file}.svg")), svg)?);
+        }
+    }
+    let mut models = Vec::new();
+    if let Some(Ok(s)) = &selection {
+        for fitted in s.sets.iter().filter_map(Candidate::fitted) {
+            let json = serde_json::to_string_pretty(&fitted.model).expect("a model serialises");
+            models.push(write(models_dir.join(model_file(&fitted.model)), &json)?);
+        }
+    }
+    let csv = dataset.as_ref().map_or_else(|| "job_id,porosity\n".to_string(), Dataset::to_csv);
+    let title = format!("Porosity report: {}", summary.name);
+    Ok(ReportFiles {
+        dataset: write(out_dir.join("dataset.csv"), &csv)?,
+        markdown: write(out_dir.join("report.md"), &document::markdown(&title, &blocks))?,
+        html: write(out_dir.join("report.html"), &document::html(&title, &blocks))?,
+        figures,
+        models,
+    })
+}
+
+/// models/ file name of a model: its features joined by '+'.
+pub fn model_file(model: &LinearModel) -> String {
+    format!("{}.json", model.features.join("+"))
+}
+
+/// `digits` significant digits, switching to exponent form outside [1e-4, 1e6).
+fn sig(x: f64, digits: i32) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let magnitude = x.abs().log10().floor() as i32;
+    if !(-4..6).contains(&magnitude) {
+        return format!("{:.*e}", (digits - 1) as usize, x);
+    }
+    format!("{x:.*}", (digits - 1 - magnitude).max(0) as usize)
+}
+
+fn duration(seconds: f64) -> String {
+    if seconds < 60.0 {
+        return format!("{seconds:.1} s");
+    }
+    let s = seconds.round() as u64;
+    if s < 3600 {
+        format!("{} min {:02} s", s / 60, s % 60)
+    } else {
+        format!("{} h {:02} min {:02} s", s / 3600, s / 60 % 60, s % 60)
+    }
+}
+
+fn value_text(v: &Value) -> String {
+    match v {
+        Value::String(s) => s.clone(),
+        other => other.to_string(),
+    }
+}
+
+/// "n = 0.0320 μ(EQ)⁻¹ − 0.00300 σ(EQ)⁻¹ + 0.287".
+fn equation(model: &LinearModel) -> String {
+    let mut s = String::from("n =");
+    for (k, (f, c)) in model.features.iter().zip(&model.coefficients).enumerate() {
+        let sign = if *c < 0.0 {
+            " −"
+        } else if k == 0 {
+            ""
+        } else {
+            " +"
+        };
+        s.push_str(&format!("{sign} {} {}", sig(c.abs(), 4), symbol(f)));
+    }
+    let sign = if model.intercept < 0.0 { "−" } else { "+" };
+    format!("{s} {sign} {}", sig(model.intercept.abs(), 4))
+}
+
+/// Grid keys whose value differs between jobs, with their values in order of appearance.
+fn varied_parameters(records: &[JobRecord]) -> Vec<(String, Vec<String>)> {
+    let mut values: BTreeMap<&String, Vec<String>> = BTreeMap::new();
+    for r in records {
+        for (k, v) in &r.parameters {
+            let list = values.entry(k).or_default();
+            let text = value_text(v);
+            if !list.contains(&text) {
+                list.push(text);
+            }
+        }
+    }
+    values.into_iter().filter(|(_, v)| v.len() > 1).map(|(k, v)| (k.clone(), v)).collect()
+}
+
+/// The shortest prefixes (at least 8 characters) that still tell the jobs apart.
+fn short_ids(records: &[JobRecord]) -> Vec<String> {
+    let longest = records.iter().map(|r| r.job_id.chars().count()).max().unwrap_or(0);
+    let prefixes = |n: usize| records.iter().map(|r| r.job_id.chars().take(n).collect::<String>()).collect::<Vec<_>>();
+    (8..longest)
+        .map(prefixes)
+        .find(|p| p.iter().collect::<std::collections::BTreeSet<_>>().len() == p.len())
+        .unwrap_or_else(|| prefixes(longest))
+}
+
+fn campaign_section(
+    blocks: &mut Vec<Block>,
+    summary: &CampaignSummary,
+    records: &[JobRecord],
+    dataset: Option<&Dataset>,
+) {
+    blocks.push(Block::Paragraph(
+        "Written by sedpack from the campaign's finished jobs, following Rettinger et al. (2022), §6.3 (single-form packings) and §7.2 (form mixtures). Porosity n is dimensionless; heights are in metres.".into(),
+    ));
+    blocks.push(Block::Heading("Campaign".into()));
+    let mut rows = vec![
+        vec!["campaign".into(), format!("`{}`", summary.name)],
+        vec!["jobs".into(), summary.jobs().to_string()],
+        vec![
+            "done / failed / pending / running".into(),
+            format!("{} / {} / {} / {}", summary.done, summary.failed, summary.pending, summary.running),
+        ],
+        vec!["packings analysed".into(), records.len().to_string()],
+        vec!["total runtime of finished jobs".into(), duration(summary.total_runtime)],
+    ];
+    if let Some(d) = dataset {
+        rows.push(vec!["features".into(), d.kind().describe().into()]);
+    }
+    for (key, values) in varied_parameters(records) {
+        rows.push(vec![format!("`{key}`"), values.join(", ")]);
+    }
+    blocks.push(Block::Table { header: vec!["".into(), "value".into()], rows });
+    if summary.failed + summary.pending + summary.running > 0 {
+        blocks.push(Block::Paragraph(format!(
+            "Only the {} finished jobs enter the analysis; {} failed, {} are pending and {} running.",
+            records.len(),
+            summary.failed,
+            summary.pending,
+            summary.running
+        )));
+    }
+}
+
+fn packings_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), ReportError> {
+    if records.is_empty() {
+        return Ok(());
+    }
+    blocks.push(Block::Heading("Packings".into()));
+    let varied = varied_parameters(records);
+    let mut header: Vec<String> = vec!["job".into()];
+    header.extend(varied.iter().map(|(k, _)| format!("`{k}`")));
+    header.extend(["μ_FL", "σ_FL", "μ_EL", "σ_EL", "porosity n"].map(String::from));
+    let stat = |r: &JobRecord, key: &str, std: bool| {
+        r.grain_statistics.get(key).map_or("–".to_string(), |&(m, s)| format!("{:.3}", if std { s } else { m }))
+    };
+    let ids = short_ids(records);
+    let rows = records
+        .iter()
+        .zip(&ids)
+        .map(|(r, id)| {
+            let mut row = vec![format!("`{id}`")];
+            row.extend(varied.iter().map(|(k, _)| r.parameters.get(k).map_or("–".into(), value_text)));
+            row.extend([stat(r, "FL", false), stat(r, "FL", true), stat(r, "EL", false), stat(r, "EL", true)]);
+            row.push(format!("{:.4}", r.porosity));
+            row
+        })
+        .collect();
+    blocks.push(Block::Paragraph(
+        "Number-based mean μ and standard deviation σ of flatness FL = S/I and elongation EL = I/L over each packing's grains, and the packing's bulk porosity (§4.4).".into(),
+    ));
+    blocks.push(Block::Table { header, rows });
+    let zingg: Vec<ZinggPacking> = records
+        .iter()
+        .filter_map(|r| {
+            let fl = r.grain_statistics.get("FL")?;
+            let el = r.grain_statistics.get("EL")?;
+            Some(ZinggPacking { mean_el: el.0, std_el: el.1, mean_fl: fl.0, std_fl: fl.1 })
+        })
+        .collect();
+    blocks.push(Block::Figure {
+        file: "zingg".into(),
+        caption: "Zingg diagram (like Fig. 11): each packing's mean elongation and flatness as a point, the standard deviations as the semi-axes of an ellipse; dashed lines are the class boundaries at 2/3.".into(),
+        svg: plots::zingg_diagram(&zingg)?,
+    });
+    let profiles: Vec<(String, Vec<_>)> =
+        records.iter().zip(ids).filter(|(r, _)| !r.profile.is_empty()).map(|(r, id)| (id, r.profile.clone())).collect();
+    if !profiles.is_empty() {
+        blocks.push(Block::Figure {
+            file: "profiles".into(),
+            caption:
+                "Porosity profiles n(z): the porosity of each horizontal slice against the slice centre height (§4.4)."
+                    .into(),
+            svg: plots::profiles(&profiles)?,
+        });
+    }
+    Ok(())
+}
+
+/// Table 6: runs of the same setup (parameters apart from the seed) against the measurement.
+fn experiment_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
+    let mut groups: Vec<(String, Vec<f64>, (f64, f64))> = Vec::new();
+    for r in records {
+        let Some(experiment) = r.experiment else { continue };
+        let setup: Vec<String> = r
+            .parameters
+            .iter()
+            .filter(|(k, _)| k.as_str() != "seed")
+            .map(|(k, v)| format!("{k} = {}", value_text(v)))
+            .collect();
+        let label = if setup.is_empty() { "all jobs".to_string() } else { setup.join(", ") };
+        match groups.iter_mut().find(|g| g.0 == label && g.2 == experiment) {
+            Some(g) => g.1.push(r.porosity),
+            None => groups.push((label, vec![r.porosity], experiment)),
+        }
+    }
+    if groups.is_empty() {
+        return;
+    }
+    blocks.push(Block::Heading("Comparison with experiment".into()));
+    blocks.push(Block::Paragraph(
+        "Like Table 6: the runs of each setup (differing only in seed), their mean and standard deviation, the measured porosity, the difference simulated − measured and the relative error (simulated − measured)/measured.".into(),
+    ));
+    let mut differences = Vec::new();
+    let rows = groups
+        .iter()
+        .map(|(label, runs, (measured, measured_std))| {
+            let mean = runs.iter().sum::<f64>() / runs.len() as f64;
+            // Population std of the runs, as Table 6 reports it (its U1 row: 0.382, 0.381, 0.386 → ± 0.002).
+            let spread = if runs.len() > 1 {
+                let var = runs.iter().map(|n| (n - mean).powi(2)).sum::<f64>() / runs.len() as f64;
+                format!("{mean:.3} ± {:.3}", var.sqrt())
+            } else {
+                format!("{mean:.3}")
+            };
+            differences.push((mean - measured).abs());
+            vec![
+                label.clone(),
+                runs.iter().map(|n| format!("{n:.3}")).collect::<Vec<_>>().join(", "),
+                spread,
+                format!("{measured:.3} ± {measured_std:.3}"),
+                format!("{:.3}", mean - measured),
+                format!("{:.2}", 100.0 * (mean - measured) / measured),
+            ]
+        })
+        .collect();
+    blocks.push(Block::Table {
+        header: ["setup", "runs", "simulated n (mean ± std)", "measured n", "difference", "relative error (%)"]
+            .map(String::from)
+            .to_vec(),
+        rows,
+    });
+    blocks.push(Block::Paragraph(format!(
+        "Mean absolute difference over the {} setups: {:.4}.",
+        differences.len(),
+        differences.iter().sum::<f64>() / differences.len() as f64
+    )));
+}
+
+fn dataset_section(blocks: &mut Vec<Block>, d: &Dataset) {
+    blocks.push(Block::Heading("Dataset".into()));
+    blocks.push(Block::Paragraph(format!(
+        "`dataset.csv` holds {} rows (packings) and {} feature columns ({}), besides `job_id` and `porosity`.",
+        d.len(),
+        d.features().len(),
+        d.kind().describe()
+    )));
+    if !d.dropped().is_empty() {
+        blocks.push(Block::Paragraph(format!(
+            "{} candidate features were dropped because they are not a finite number for every packing:",
+            d.dropped().len()
+        )));
+        blocks.push(Block::Table {
+            header: vec!["feature".into(), "reason".into()],
+            rows: d.dropped().iter().map(|x| vec![format!("`{}`", x.feature), x.reason.clone()]).collect(),
+        });
+    }
+}
+
+fn ranking_section(blocks: &mut Vec<Block>, d: &Dataset, s: &Selection) -> Result<(), ReportError> {
+    blocks.push(Block::Heading("Feature ranking".into()));
+    blocks.push(Block::Paragraph(format!(
+        "Pearson's correlation coefficient r of every feature with porosity, ranked by |r| (§6.3.2). The primary feature is **`{}`** ({}) with r = {:.3}.",
+        s.primary.feature,
+        symbol(&s.primary.feature),
+        s.primary.r
+    )));
+    let rows = s
+        .ranking
+        .ranked
+        .iter()
+        .enumerate()
+        .map(|(k, c)| vec![(k + 1).to_string(), format!("`{}`", c.feature), symbol(&c.feature), format!("{:.3}", c.r)])
+        .collect();
+    blocks.push(Block::Table { header: ["rank", "feature", "symbol", "r"].map(String::from).to_vec(), rows });
+    if !s.ranking.constant.is_empty() {
+        blocks.push(Block::Paragraph(format!(
+            "Not ranked, being constant over the packings: {}.",
+            s.ranking.constant.iter().map(|f| format!("`{f}`")).collect::<Vec<_>>().join(", ")
+        )));
+    }
+    let x = d.column(&s.primary.feature).expect("the primary is a column");
+    let points: Vec<(f64, f64)> = x.iter().copied().zip(d.porosity().iter().copied()).collect();
+    let line = s.pairs[0].fitted().map(|f| {
+        (
+            f.model.coefficients[0],
+            f.model.intercept,
+            format!(
+                "n = {} x + {} (r = {:.3})",
+                sig(f.model.coefficients[0], 3),
+                sig(f.model.intercept, 3),
+                s.primary.r
+            ),
+        )
+    });
+    let x_label = format!("{} (–)", symbol(&s.primary.feature));
+    blocks.push(Block::Figure {
+        file: "primary".into(),
+        caption: format!(
+            "Porosity against the primary feature {} with the implied linear model (like Fig. 8).",
+            symbol(&s.primary.feature)
+        ),
+        svg: plots::scatter(&ScatterPlot {
+            title: "Porosity against the primary feature",
+            x_label: &x_label,
+            y_label: "porosity n (–)",
+            points: &points,
+            line,
+        })?,
+    });
+    Ok(())
+}
+
+fn correlation_section(blocks: &mut Vec<Block>, d: &Dataset) -> Result<(), ReportError> {
+    let (names, what): (Vec<String>, &str) = match d.kind() {
+        FeatureKind::SingleForm => (FACTORS.iter().map(|f| f.to_string()).collect(), "the 13 form factors"),
+        FeatureKind::Mixture => {
+            (FACTORS.iter().map(|f| format!("mean_{f}")).collect(), "the packing means of the 13 form factors")
+        }
+    };
+    let matrix = correlation_matrix(d, &names);
+    if matrix.features.len() < 2 {
+        return Ok(());
+    }
+    blocks.push(Block::Heading("Correlation of the form factors".into()));
+    blocks.push(Block::Figure {
+        file: "correlation".into(),
+        caption: format!("Pearson correlation of {what} over the packings (like Fig. 3); grey cells are undefined (a constant factor)."),
+        svg: plots::heat_map("Correlation of the form factors", &matrix)?,
+    });
+    Ok(())
+}
+
+fn filter_section(blocks: &mut Vec<Block>, s: &Selection) {
+    blocks.push(Block::Heading("Correlation filter".into()));
+    blocks.push(Block::Paragraph(format!(
+        "Features whose |r| with the primary feature `{}` exceeds {} carry little new information and are removed (§6.3.3): {} removed, {} kept.",
+        s.primary.feature,
+        s.filter.threshold,
+        s.filter.removed.len(),
+        s.filter.kept.len()
+    )));
+    if !s.filter.removed.is_empty() {
+        blocks.push(Block::Table {
+            header: ["removed feature", "symbol", "r with the primary"].map(String::from).to_vec(),
+            rows: s
+                .filter
+                .removed
+                .iter()
+                .map(|c| vec![format!("`{}`", c.feature), symbol(&c.feature), format!("{:.3}", c.r)])
+                .collect(),
+        });
+    }
+}
+
+fn metrics(c: &Candidate, bold: bool) -> [String; 2] {
+    match c.fitted().and_then(|f| f.model.cv) {
+        Some(cv) => {
+            let mae = format!("{:.2}", cv.mae * 1e3);
+            [if bold { format!("**{mae}**") } else { mae }, format!("{:.3}", cv.r2)]
+        }
+        None => ["–".into(), "–".into()],
+    }
+}
+
+fn pairs_section(blocks: &mut Vec<Block>, s: &Selection) {
+    blocks.push(Block::Heading("Feature pairs (Table 9)".into()));
+    blocks.push(Block::Paragraph(format!(
+        "The primary feature alone and with each kept feature, fitted by least squares; {}-fold cross-validated mean absolute error (MAE, ×10⁻³) and R² of the held-out predictions. The three smallest errors are in bold.",
+        s.folds.iter().max().map_or(0, |m| m + 1)
+    )));
+    let mut maes: Vec<f64> = s.pairs.iter().filter_map(Candidate::mae).collect();
+    maes.sort_by(f64::total_cmp);
+    let third = maes.get(2.min(maes.len().saturating_sub(1))).copied();
+    let rows = s
+        .pairs
+        .iter()
+        .map(|c| {
+            let bold = matches!((c.mae(), third), (Some(m), Some(t)) if m <= t);
+            let [mae, r2] = metrics(c, bold);
+            let with = c.features.get(1).map_or("(primary alone)".to_string(), |f| format!("`{f}` ({})", symbol(f)));
+            let coefficients = match &c.result {
+                Ok(f) => {
+                    f.model.coefficients.iter().map(|x| sig(*x, 3)).collect::<Vec<_>>().join(", ")
+                        + &format!("; {}", sig(f.model.intercept, 3))
+                }
+                Err(e) => format!("not fitted: {e}"),
+            };
+            vec![with, mae, r2, coefficients]
+        })
+        .collect();
+    blocks.push(Block::Table {
+        header: ["with the primary", "MAE (×10⁻³)", "R²", "coefficients; intercept"].map(String::from).to_vec(),
+        rows,
+    });
+    if let Some(q) = &s.second {
+        blocks.push(Block::Paragraph(format!(
+            "Second factor: `{q}` ({}), the partner of another form factor with the smallest MAE{}.",
+            symbol(q),
+            if s.primary.feature.contains("mean_") || s.primary.feature.contains("std_") {
+                " among those of the same statistic as the primary"
+            } else {
+                ""
+            }
+        )));
+    }
+}
+
+fn sets_section(blocks: &mut Vec<Block>, d: &Dataset, s: &Selection) -> Result<(), ReportError> {
+    blocks.push(Block::Heading("Models (Table 10)".into()));
+    blocks.push(Block::Paragraph(
+        "Multivariate feature sets built from the primary P, its counterpart of the other statistic P′ (μ ↔ σ), the second factor Q and its counterpart Q′, in the order of Table 10: P; P + P′; P + P′ + Q; P + P′ + Q + Q′; P + Q; P + P′ + Q′. The paper's own final set is added for comparison when the procedure did not reach it.".into(),
+    ));
+    let mut columns: Vec<String> = Vec::new();
+    for c in &s.sets {
+        for f in &c.features {
+            if !columns.contains(f) {
+                columns.push(f.clone());
+            }
+        }
+    }
+    let mut header: Vec<String> = columns.iter().map(|f| symbol(f)).collect();
+    header.extend(["MAE (×10⁻³)", "R²", "note"].map(String::from));
+    let rows = s
+        .sets
+        .iter()
+        .enumerate()
+        .map(|(k, c)| {
+            let mut row: Vec<String> =
+                columns.iter().map(|f| if c.features.contains(f) { "✓".into() } else { "".into() }).collect();
+            row.extend(metrics(c, false));
+            let mut notes = Vec::new();
+            if s.chosen == Some(k) {
+                notes.push("**chosen**".to_string());
+            }
+            if s.paper_set == Some(k) {
+                notes.push("paper's set".into());
+            }
+            match &c.result {
+                Ok(f) => notes.push(format!("`models/{}`", model_file(&f.model))),
+                Err(e) => notes.push(format!("not fitted: {e}")),
+            }
+            row.push(notes.join("; "));
+            row
+        })
+        .collect();
+    blocks.push(Block::Table { header, rows });
+    blocks.push(Block::List(
+        s.sets
+            .iter()
+            .filter_map(Candidate::fitted)
+            .map(|f| format!("{}: {}", set_label(&f.model.features), equation(&f.model)))
+            .collect(),
+    ));
+
+    let Some(chosen) = s.chosen_model() else {
+        blocks.push(Block::Paragraph("No feature set could be fitted, so no model is chosen.".into()));
+        return Ok(());
+    };
+    let model = &chosen.model;
+    let cv = model.cv.expect("fitted models carry their cross-validation");
+    blocks.push(Block::Subheading("Chosen model".into()));
+    blocks.push(Block::Paragraph(format!(
+        "Like the paper (§6.3.3, §7.2: \"generally include all four features\"), the largest feature set the procedure built is kept (ties to the smaller MAE): **{}**, fitted on all {} packings. Cross-validation ({}-fold): MAE = {:.2}×10⁻³, R² = {:.3}. Saved as `models/{}`; apply it with `sedpack predict --model models/{}`.",
+        equation(model),
+        d.len(),
+        cv.folds,
+        cv.mae * 1e3,
+        cv.r2,
+        model_file(model),
+        model_file(model)
+    )));
+    blocks.push(Block::Table {
+        header: ["feature", "symbol", "coefficient", "training range"].map(String::from).to_vec(),
+        rows: model
+            .features
+            .iter()
+            .zip(&model.coefficients)
+            .map(|(f, c)| {
+                let range =
+                    model.ranges.get(f).map_or("–".into(), |r| format!("[{}, {}]", sig(r[0], 4), sig(r[1], 4)));
+                vec![format!("`{f}`"), symbol(f), sig(*c, 4), range]
+            })
+            .chain(std::iter::once(vec!["intercept".into(), "".into(), sig(model.intercept, 4), "".into()]))
+            .collect(),
+    });
+    blocks.push(Block::Figure {
+        file: "predicted-vs-observed".into(),
+        caption: "Predicted against observed porosity for the chosen model (like Figs. 9 and 12); the black line is perfect agreement.".into(),
+        svg: plots::predicted_vs_observed(&set_label(&model.features), d.porosity(), &chosen.fitted, &chosen.held_out)?,
+    });
+    Ok(())
+}
+
+fn method_section(blocks: &mut Vec<Block>, options: &SelectionOptions, dataset: Option<&Dataset>) {
+    blocks.push(Block::Heading("Method".into()));
+    let mut items = vec![
+        "Grain statistics are number-based: mean and population standard deviation of each form factor over the packing's grains, as stored per job.".to_string(),
+        format!(
+            "A campaign is single-form when every packing has σ_FL and σ_EL ≤ {:e}; otherwise the 104 mixture features are built.",
+            crate::dataset::SINGLE_FORM_STD_TOLERANCE
+        ),
+        "Ties in |r| (within 1e-12) go to the earlier dataset column (Table 1 order, the factor before its inverse).".to_string(),
+        format!(
+            "Correlation filter threshold |r| > {}; {}-fold cross-validation (fewer when there are fewer packings), folds dealt at random from seed {} and shared by every fit, so errors compare like for like.",
+            options.threshold, options.folds, options.seed
+        ),
+        "Least squares with intercept through linfa-linear (Householder QR); designs with too few rows, a constant feature or collinear features are reported rather than fitted.".to_string(),
+        "MAE and R² are of the held-out predictions: each packing is predicted by the model fitted without its fold; R² = 1 − Σ(n − n̂)² / Σ(n − n̄)².".to_string(),
+    ];
+    if dataset.is_some_and(|d| d.kind() == FeatureKind::Mixture) {
+        items.push("A form-mixture model uses 1/σ and is not valid for a single form (§7.2); it applies within the training ranges listed with it.".into());
+    }
+    blocks.push(Block::List(items));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_are_printed_with_sensible_precision() {
+        assert_eq!(sig(0.0321456, 3), "0.0321");
+        assert_eq!(sig(0.287, 4), "0.2870");
+        assert_eq!(sig(-3.4567, 3), "-3.46");
+        assert_eq!(sig(1234.7, 3), "1235");
+        assert_eq!(sig(0.00001234, 3), "1.23e-5");
+        assert_eq!(sig(-0.000910, 3), "-0.000910");
+        assert_eq!(duration(12.34), "12.3 s");
+        assert_eq!(duration(3725.0), "1 h 02 min 05 s");
+    }
+
+    #[test]
+    fn job_ids_are_shortened_only_as_far_as_they_stay_distinct() {
+        let record = |id: &str| JobRecord {
+            job_id: id.into(),
+            porosity: 0.3,
+            profile: vec![],
+            parameters: BTreeMap::new(),
+            grain_statistics: BTreeMap::new(),
+            experiment: None,
+        };
+        let records = [record("0123456789abcdef"), record("0123456789abXdef"), record("short")];
+        assert_eq!(short_ids(&records), ["0123456789abc", "0123456789abX", "short"]);
+    }
+
+    #[test]
+    fn equations_read_like_the_paper() {
+        let model = LinearModel {
+            name: "m".into(),
+            features: vec!["inv_mean_EQ".into(), "inv_std_EQ".into()],
+            coefficients: vec![0.032, -0.003],
+            intercept: 0.287,
+            cv: None,
+            ranges: BTreeMap::new(),
+            campaign: None,
+        };
+        assert_eq!(equation(&model), "n = 0.03200 μ(EQ)⁻¹ − 0.003000 σ(EQ)⁻¹ + 0.2870");
+        assert_eq!(model_file(&model), "inv_mean_EQ+inv_std_EQ.json");
+    }
+}

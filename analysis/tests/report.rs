@@ -1,0 +1,267 @@
+//! The report of synthetic campaigns: porosity planted as a known linear function of features
+//! plus small noise; the report must find it, save it, and write well-formed, offline files.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use analysis::dataset::mixture_feature_names;
+use analysis::form_factors::{form_feature_names, grain_statistics};
+use analysis::model::LinearModel;
+use analysis::record::{CampaignSummary, JobRecord, ProfilePoint};
+use analysis::report::write_report;
+use analysis::selection::SelectionOptions;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde_json::json;
+
+/// Grains of a packing: FL and EL on a 4 × 4 grid at μ ± 0.5σ, ± 1.5σ, clipped to [0.1, 1]
+/// like the sampler's redrawing range.
+fn grains(mu_fl: f64, sigma_fl: f64, mu_el: f64, sigma_el: f64) -> Vec<(f64, f64)> {
+    let z = [-1.5, -0.5, 0.5, 1.5];
+    let clip = |x: f64| x.clamp(0.1, 1.0);
+    z.iter().flat_map(|a| z.iter().map(move |b| (clip(mu_fl + a * sigma_fl), clip(mu_el + b * sigma_el)))).collect()
+}
+
+fn profile(porosity: f64) -> Vec<ProfilePoint> {
+    (0..30)
+        .map(|k| ProfilePoint {
+            z: 0.0005 + 0.001 * k as f64,
+            n: if k < 25 { porosity } else { 1.0 - (30 - k) as f64 * 0.1 },
+        })
+        .collect()
+}
+
+/// Planted model, Eq. 24's form with Eq. 23-like coefficients.
+const PLANTED: [(&str, f64); 4] =
+    [("inv_mean_EQ", 0.032), ("inv_std_EQ", -0.003), ("inv_mean_EL", 0.011), ("inv_std_EL", 0.002)];
+const INTERCEPT: f64 = 0.287;
+const NOISE: f64 = 2e-4;
+
+fn mixture_campaign() -> Vec<JobRecord> {
+    let mut rng = ChaCha8Rng::seed_from_u64(2022);
+    let mut records = Vec::new();
+    for mu_fl in [0.4, 0.6, 0.8] {
+        for mu_el in [0.5, 0.7, 0.85] {
+            for sigma_fl in [0.1, 0.2] {
+                for sigma_el in [0.1, 0.15] {
+                    let stats = grain_statistics(&grains(mu_fl, sigma_fl, mu_el, sigma_el));
+                    let feature = |name: &str| match name {
+                        "inv_mean_EQ" => 1.0 / stats["EQ"].0,
+                        "inv_std_EQ" => 1.0 / stats["EQ"].1,
+                        "inv_mean_EL" => 1.0 / stats["EL"].0,
+                        "inv_std_EL" => 1.0 / stats["EL"].1,
+                        _ => unreachable!(),
+                    };
+                    let porosity = INTERCEPT
+                        + PLANTED.iter().map(|(f, c)| c * feature(f)).sum::<f64>()
+                        + rng.random_range(-NOISE..NOISE);
+                    records.push(JobRecord {
+                        job_id: format!("{:016x}", (records.len() as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15)),
+                        porosity,
+                        profile: profile(porosity),
+                        parameters: BTreeMap::from([
+                            ("grains.form.mu_fl".to_string(), json!(mu_fl)),
+                            ("grains.form.mu_el".to_string(), json!(mu_el)),
+                            ("grains.form.sigma_fl".to_string(), json!(sigma_fl)),
+                            ("grains.form.sigma_el".to_string(), json!(sigma_el)),
+                            ("seed".to_string(), json!(1)),
+                        ]),
+                        grain_statistics: stats,
+                        experiment: None,
+                    });
+                }
+            }
+        }
+    }
+    records
+}
+
+fn summary(name: &str, done: usize) -> CampaignSummary {
+    CampaignSummary { name: name.into(), pending: 0, running: 0, done, failed: 1, total_runtime: 7384.0 }
+}
+
+/// Two-pass Pearson, independent of the library.
+fn pearson(x: &[f64], y: &[f64]) -> f64 {
+    let n = x.len() as f64;
+    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let sxx: f64 = x.iter().map(|a| (a - mx).powi(2)).sum();
+    let syy: f64 = y.iter().map(|b| (b - my).powi(2)).sum();
+    sxy / (sxx * syy).sqrt()
+}
+
+/// dataset.csv as (header, rows of job id and numbers).
+fn read_csv(path: &Path) -> (Vec<String>, Vec<(String, Vec<f64>)>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| {
+            let mut cells = l.split(',');
+            let id = cells.next().unwrap().to_string();
+            (id, cells.map(|c| c.parse().unwrap()).collect())
+        })
+        .collect();
+    (header, rows)
+}
+
+/// Every SVG parses as XML, the whole HTML parses as XML, and nothing is fetched from outside.
+fn check_html(out: &Path, min_svgs: usize) -> String {
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let doc = roxmltree::Document::parse_with_options(
+        &html,
+        roxmltree::ParsingOptions { allow_dtd: true, ..Default::default() },
+    )
+    .unwrap_or_else(|e| panic!("report.html is not well-formed: {e}"));
+    let svgs = doc.descendants().filter(|n| n.tag_name().name() == "svg").count();
+    assert!(svgs >= min_svgs, "{svgs} inline SVGs");
+    let mut rest = html.as_str();
+    while let Some(start) = rest.find("<svg") {
+        let end = rest[start..].find("</svg>").unwrap() + start + "</svg>".len();
+        roxmltree::Document::parse(&rest[start..end])
+            .unwrap_or_else(|e| panic!("an inline SVG is not well-formed: {e}"));
+        rest = &rest[end..];
+    }
+    for figure in std::fs::read_dir(out.join("figures")).unwrap() {
+        let text = std::fs::read_to_string(figure.unwrap().path()).unwrap();
+        roxmltree::Document::parse(&text).unwrap();
+    }
+    for banned in ["<script", "<link", "<img", "<iframe", "url(", "href", "src="] {
+        assert!(!html.contains(banned), "report.html contains {banned}");
+    }
+    let without_namespaces = html.replace("xmlns=\"http://www.w3.org/2000/svg\"", "");
+    assert!(!without_namespaces.contains("http"), "report.html refers to something online");
+    html
+}
+
+#[test]
+fn a_mixture_campaign_report_recovers_the_planted_model() {
+    let records = mixture_campaign();
+    let out = tempfile::tempdir().unwrap();
+    let files =
+        write_report(&summary("synthetic-fm", records.len()), &records, &SelectionOptions::default(), out.path())
+            .unwrap();
+
+    // dataset.csv: the header is job_id, porosity, then mixture features in their order.
+    let (header, rows) = read_csv(&files.dataset);
+    assert_eq!(header[..2], ["job_id", "porosity"]);
+    let all = mixture_feature_names();
+    let positions: Vec<usize> =
+        header[2..].iter().map(|h| all.iter().position(|n| n == h).expect("a mixture feature")).collect();
+    assert!(positions.windows(2).all(|w| w[0] < w[1]), "columns keep the feature order");
+    assert_eq!(rows.len(), records.len());
+    let md = std::fs::read_to_string(&files.markdown).unwrap();
+    for dropped in all.iter().filter(|n| !header.contains(n)) {
+        assert!(md.contains(&format!("| `{dropped}` |")), "dropped {dropped} is explained in the report");
+    }
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap() - 1;
+    for ((id, values), r) in rows.iter().zip(&records) {
+        assert_eq!(id, &r.job_id);
+        assert_eq!(values[0], r.porosity, "porosity written exactly");
+        assert_eq!(values[col("inv_mean_EQ")], 1.0 / r.grain_statistics["EQ"].0);
+    }
+
+    // The primary is the column with the largest |r| by an independent two-pass computation.
+    let porosity: Vec<f64> = rows.iter().map(|r| r.1[0]).collect();
+    let (primary, r) = header[2..]
+        .iter()
+        .map(|h| {
+            let x: Vec<f64> = rows.iter().map(|row| row.1[col(h)]).collect();
+            (h.clone(), pearson(&x, &porosity))
+        })
+        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+        .unwrap();
+    assert!(md.contains(&format!("The primary feature is **`{primary}`**")), "primary {primary}");
+    assert!(md.contains(&format!("with r = {r:.3}.")));
+
+    // The paper's four-feature set is always fitted; its coefficients are the planted ones.
+    let file = out.path().join("models/inv_mean_EQ+inv_std_EQ+inv_mean_EL+inv_std_EL.json");
+    let model: LinearModel = serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    assert_eq!(model.campaign.as_deref(), Some("synthetic-fm"));
+    // Uniform noise of ±2e-4 (σ = 1.2e-4) on 36 packings whose features spread by ~1 (1/μ) to
+    // ~5 (1/σ): standard errors of the coefficients are ~1e-5 to ~5e-5 (the 1/σ features are
+    // correlated), so 2e-4 is several of them and still tells the 0.002 coefficient from 0; the
+    // intercept, extrapolated to zero features, gets 1e-3.
+    for ((f, planted), (name, got)) in PLANTED.iter().zip(model.features.iter().zip(&model.coefficients)) {
+        assert_eq!(f, name);
+        assert!((got - planted).abs() < 2e-4, "{name}: {got} vs {planted}");
+    }
+    assert!((model.intercept - INTERCEPT).abs() < 1e-3, "{}", model.intercept);
+    let cv = model.cv.unwrap();
+    assert_eq!(cv.folds, 10);
+    // Held-out errors of a correct model are of the noise size (mean |U(−a, a)| = a/2).
+    assert!(cv.mae < 3.0 * NOISE && cv.r2 > 0.99, "{cv:?}");
+    for f in &model.features {
+        let x: Vec<f64> = rows.iter().map(|row| row.1[col(f)]).collect();
+        let want =
+            [x.iter().copied().fold(f64::INFINITY, f64::min), x.iter().copied().fold(f64::NEG_INFINITY, f64::max)];
+        assert_eq!(model.ranges[f], want, "training range of {f}");
+    }
+    assert!(files.models.contains(&file));
+    assert!(md.contains("Feature pairs (Table 9)") && md.contains("Models (Table 10)"));
+    assert!(md.contains("**chosen**"));
+
+    let html = check_html(out.path(), 5);
+    assert!(html.contains("Zingg diagram") && html.contains("Porosity profiles n(z)"));
+    assert!(html.contains("elongation EL = I/L (–)"), "axis labels with units are text elements");
+    assert_eq!(files.figures.len(), 5, "Zingg, profiles, primary, correlation, predicted vs observed");
+}
+
+/// Table 6's U1 and U3 runs with their experiments, as single-form packings.
+fn validation_campaign() -> Vec<JobRecord> {
+    let mut records = Vec::new();
+    let cases = [
+        ("U1", [0.382, 0.381, 0.386], (0.371, 0.001), (0.6, 0.7)),
+        ("U3", [0.367, 0.369, 0.372], (0.356, 0.003), (0.5, 0.8)),
+    ];
+    for (case, runs, experiment, (fl, el)) in cases {
+        for (seed, n) in runs.iter().enumerate() {
+            records.push(JobRecord {
+                job_id: format!("{case}-{seed}"),
+                porosity: *n,
+                profile: vec![],
+                parameters: BTreeMap::from([("grains.size".into(), json!(case)), ("seed".into(), json!(seed + 1))]),
+                grain_statistics: grain_statistics(&[(fl, el); 3]),
+                experiment: Some(experiment),
+            });
+        }
+    }
+    records
+}
+
+#[test]
+fn a_single_form_validation_report_has_table_6() {
+    let records = validation_campaign();
+    let out = tempfile::tempdir().unwrap();
+    let files = write_report(&summary("validation", 6), &records, &SelectionOptions::default(), out.path()).unwrap();
+    let md = std::fs::read_to_string(&files.markdown).unwrap();
+    // Table 6, U1: mean 0.383 ± 0.002 (population std), 0.383 − 0.371 = 0.012, 3.23 %;
+    // U3: 0.369 ± 0.002, 0.369333 − 0.356 = 0.013, 3.75 %.
+    assert!(
+        md.contains("| grains.size = U1 | 0.382, 0.381, 0.386 | 0.383 ± 0.002 | 0.371 ± 0.001 | 0.012 | 3.23 |"),
+        "{md}"
+    );
+    assert!(
+        md.contains("| grains.size = U3 | 0.367, 0.369, 0.372 | 0.369 ± 0.002 | 0.356 ± 0.003 | 0.013 | 3.75 |"),
+        "{md}"
+    );
+    let (header, rows) = read_csv(&files.dataset);
+    assert_eq!(header[2..], form_feature_names()[..], "single-form campaigns get the 26 factors");
+    assert_eq!(rows.len(), 6);
+    assert!(md.contains("single-form packings"));
+    check_html(out.path(), 3);
+}
+
+#[test]
+fn too_few_packings_still_give_a_report_that_says_why() {
+    let records: Vec<JobRecord> = validation_campaign().into_iter().take(2).collect();
+    let out = tempfile::tempdir().unwrap();
+    let files = write_report(&summary("tiny", 2), &records, &SelectionOptions::default(), out.path()).unwrap();
+    let md = std::fs::read_to_string(&files.markdown).unwrap();
+    assert!(md.contains("No model could be built: 2 finished jobs are too few"), "{md}");
+    assert!(files.models.is_empty());
+    check_html(out.path(), 1);
+
+    let empty = write_report(&summary("empty", 0), &[], &SelectionOptions::default(), out.path()).unwrap();
+    assert_eq!(std::fs::read_to_string(empty.dataset).unwrap(), "job_id,porosity\n");
+}

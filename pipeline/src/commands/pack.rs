@@ -1,0 +1,157 @@
+//! `sedpack pack JOB.yaml`: one packing, with progress on the terminal; writes result.json,
+//! profile.csv, particles.csv and packing.vtk.
+
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use anyhow::Context;
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::Serialize;
+use serde_json::{Map, Value, json};
+use solver::packing::{Packing, PackingResult, Phase};
+
+use crate::cli::PackArgs;
+use crate::output::{Table, number, print_json};
+use crate::spec::{Experiment, JobSpec, read_job};
+use crate::vtk;
+
+/// Steps between progress updates: 0.05 s of simulated time at the paper's Δt.
+const STEPS_PER_UPDATE: u64 = 10_000;
+
+#[derive(Serialize)]
+struct ResultFile<'a> {
+    name: &'a str,
+    porosity: f64,
+    z_minus: f64,
+    z_plus: f64,
+    surface: f64,
+    particles: usize,
+    simulated_time: f64,
+    steps: u64,
+    wall_time: f64,
+    experiment: Option<Experiment>,
+    statistics: Map<String, Value>,
+    profile: &'a [solver::porosity::ProfilePoint],
+}
+
+pub fn run(args: &PackArgs) -> anyhow::Result<()> {
+    let job = read_job(&args.job)?;
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from(&job.name));
+    let mut packing = Packing::new(job.packing.clone()).with_context(|| format!("{}", args.job.display()))?;
+    let bar = progress_bar(args.json);
+    loop {
+        let phase = packing.advance(STEPS_PER_UPDATE).with_context(|| format!("{}", args.job.display()))?;
+        let p = packing.progress();
+        bar.set_message(format!(
+            "{:<10} t = {:7.3} s  grains {:6} ({:3.0} % of the mass)  contacts {:7}",
+            p.phase.name(),
+            p.time,
+            p.grains,
+            100.0 * p.created,
+            p.contacts
+        ));
+        bar.tick();
+        if phase == Phase::Converged {
+            break;
+        }
+    }
+    bar.finish_and_clear();
+    let result = packing.result().with_context(|| format!("{}", args.job.display()))?;
+    write_outputs(&out, &job, &packing, &result)?;
+    let record = result_file(&job, &result);
+    if args.json {
+        return print_json(&record);
+    }
+    let mut table = Table::default();
+    table.row("porosity", format!("{:.4}", record.porosity));
+    if let Some(e) = &job.experiment {
+        table.row("experiment", format!("{:.4}{}", e.porosity, e.std.map(|s| format!(" ± {s}")).unwrap_or_default()));
+    }
+    table
+        .row(
+            "evaluated",
+            format!(
+                "{} m – {} m (surface {} m)",
+                number(record.z_minus),
+                number(record.z_plus),
+                number(record.surface)
+            ),
+        )
+        .row("particles", record.particles.to_string())
+        .row("simulated time", format!("{:.3} s in {} steps", record.simulated_time, record.steps))
+        .row("wall time", format!("{:.1} s", record.wall_time))
+        .row("output", out.display().to_string());
+    table.print();
+    Ok(())
+}
+
+fn progress_bar(hidden: bool) -> ProgressBar {
+    if hidden {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new_spinner();
+    bar.set_style(ProgressStyle::with_template("{spinner} [{elapsed_precise}] {msg}").expect("valid template"));
+    bar.enable_steady_tick(Duration::from_millis(250));
+    bar
+}
+
+fn result_file<'a>(job: &'a JobSpec, result: &'a PackingResult) -> ResultFile<'a> {
+    let mut statistics = Map::new();
+    for s in &result.statistics {
+        statistics.insert(format!("mean_{}", s.name), json!(s.mean));
+        statistics.insert(format!("std_{}", s.name), json!(s.std));
+    }
+    ResultFile {
+        name: &job.name,
+        porosity: result.porosity.bulk,
+        z_minus: result.porosity.z_minus,
+        z_plus: result.porosity.z_plus,
+        surface: result.porosity.surface,
+        particles: result.particles,
+        simulated_time: result.simulated_time,
+        steps: result.steps,
+        wall_time: result.wall_time.as_secs_f64(),
+        experiment: job.experiment,
+        statistics,
+        profile: &result.porosity.profile,
+    }
+}
+
+fn create(path: &Path) -> anyhow::Result<BufWriter<std::fs::File>> {
+    Ok(BufWriter::new(std::fs::File::create(path).with_context(|| format!("{}", path.display()))?))
+}
+
+fn write_outputs(out: &Path, job: &JobSpec, packing: &Packing, result: &PackingResult) -> anyhow::Result<()> {
+    std::fs::create_dir_all(out).with_context(|| format!("{}", out.display()))?;
+    let mut file = create(&out.join("result.json"))?;
+    serde_json::to_writer_pretty(&mut file, &result_file(job, result))?;
+    writeln!(file)?;
+
+    let mut file = create(&out.join("profile.csv"))?;
+    writeln!(file, "z,n")?;
+    for p in &result.porosity.profile {
+        writeln!(file, "{},{}", p.z, p.n)?;
+    }
+
+    let bodies = &packing.simulation.bodies;
+    let mut file = create(&out.join("particles.csv"))?;
+    writeln!(file, "id,shape,x,y,z,qw,qx,qy,qz,a,b,c,D,volume")?;
+    for k in 0..bodies.len() {
+        let (x, q) = (bodies.position[k], bodies.orientation[k]);
+        let (kind, axes) = match &bodies.shape[k] {
+            solver::dem::Shape::Sphere { radius } => ("sphere", [*radius; 3]),
+            solver::dem::Shape::Ellipsoid { semi_axes } => ("ellipsoid", [semi_axes.x, semi_axes.y, semi_axes.z]),
+        };
+        writeln!(
+            file,
+            "{k},{kind},{},{},{},{},{},{},{},{},{},{},{},{}",
+            x.x, x.y, x.z, q.w, q.i, q.j, q.k, axes[0], axes[1], axes[2], packing.grains[k].size, bodies.volume[k]
+        )?;
+    }
+    let sizes: Vec<f64> = packing.grains.iter().map(|g| g.size).collect();
+    let mut file = create(&out.join("packing.vtk"))?;
+    vtk::write_packing(&mut file, bodies, &sizes, &format!("sedpack packing {}", job.name))?;
+    file.flush()?;
+    Ok(())
+}

@@ -1,0 +1,107 @@
+//! Particle-steps per second of the DEM engine on settled beds, with 1 and 2 threads.
+//!
+//! The sphere bed of 2,450 grains is the LAMMPS comparison bed of `../shared/peers/lammps`:
+//! d = 6.7 mm, ρ = 2650 kg/m³ in water, a 0.05 m periodic square, a 7 × 7 × 50 lattice with
+//! random velocities in ±0.2 m/s, poured for 0.5 s and settled. Settled beds are cached in
+//! target/sedpack-bench/ so that only the first run pays for the settling.
+
+use std::path::PathBuf;
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use nalgebra::{UnitQuaternion, Vector3};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use solver::dem::{Calibration, Domain, NewBody, Settings, Shape, Simulation};
+
+struct Bed {
+    name: &'static str,
+    width: f64,
+    per_row: usize,
+    layers: usize,
+    shape: fn(&mut ChaCha8Rng) -> Shape,
+}
+
+fn sphere(_: &mut ChaCha8Rng) -> Shape {
+    Shape::Sphere { radius: 3.35e-3 }
+}
+
+fn settings() -> Settings {
+    Settings {
+        density: 2650.0,
+        fluid_density: 1000.0,
+        gravity: Vector3::new(0.0, 0.0, -9.81),
+        restitution: 0.1,
+        collision_time: 2e-4,
+        poisson_ratio: 0.22,
+        friction: 0.5,
+        time_step: 5e-6,
+        skin: 1e-3,
+        calibration: Calibration::Discrete { time_step: 5e-6 },
+    }
+}
+
+fn settled(bed: &Bed) -> Simulation {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/sedpack-bench");
+    let path = dir.join(format!("{}.json", bed.name));
+    if let Ok(text) = std::fs::read_to_string(&path) {
+        if let Ok(sim) = serde_json::from_str(&text) {
+            return sim;
+        }
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(12345);
+    let mut sim = Simulation::new(Domain::Periodic { width: bed.width }, settings()).unwrap();
+    let a = bed.width / bed.per_row as f64;
+    for k in 0..bed.layers {
+        for j in 0..bed.per_row {
+            for i in 0..bed.per_row {
+                let mut v = || rng.random_range(-0.2..0.2);
+                let velocity = Vector3::new(v(), v(), v());
+                let shape = (bed.shape)(&mut rng);
+                sim.add_body(NewBody {
+                    shape,
+                    position: Vector3::new((i as f64 + 0.5) * a, (j as f64 + 0.5) * a, 0.005 + 0.01 * k as f64),
+                    orientation: UnitQuaternion::identity(),
+                    velocity,
+                    angular_velocity: Vector3::zeros(),
+                });
+            }
+        }
+    }
+    eprintln!("settling {} ({} grains), cached in {}", bed.name, sim.bodies.len(), path.display());
+    while sim.time < 0.5 {
+        sim.step().unwrap();
+    }
+    // Damping (Eq. 15) brings the poured bed to rest quickly.
+    sim.damping = Some(1e-3);
+    while sim.bodies.velocity.iter().map(|v| v.norm_squared()).sum::<f64>() / sim.bodies.len() as f64 > 1e-8 {
+        sim.step().unwrap();
+    }
+    sim.damping = None;
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(&path, serde_json::to_string(&sim).unwrap()).unwrap();
+    sim
+}
+
+fn particle_steps(c: &mut Criterion) {
+    let beds = [
+        Bed { name: "spheres-2450", width: 0.05, per_row: 7, layers: 50, shape: sphere },
+        Bed { name: "spheres-8112", width: 0.091, per_row: 13, layers: 48, shape: sphere },
+    ];
+    let mut group = c.benchmark_group("settled_bed");
+    group.sample_size(10);
+    for bed in &beds {
+        let base = settled(bed);
+        group.throughput(Throughput::Elements(base.bodies.len() as u64));
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let mut sim = base.clone();
+            group.bench_function(BenchmarkId::new(bed.name, format!("{threads} threads")), |b| {
+                pool.install(|| b.iter(|| sim.step().unwrap()))
+            });
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, particle_steps);
+criterion_main!(benches);

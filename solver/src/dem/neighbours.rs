@@ -1,0 +1,239 @@
+//! Broad phase: linked cells (with periodic images) build a Verlet list of body pairs whose
+//! bounding spheres come within a skin distance; the list is reused until some body has moved
+//! more than half the skin, and each pair carries its contact history across rebuilds.
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+use super::body::Bodies;
+use super::contact_law::ContactHistory;
+use super::domain::Domain;
+use crate::SolverError;
+
+/// Two bodies i < j whose bounding spheres, with j moved by `shift` (its periodic image nearest
+/// to i), are closer than the skin.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Pair {
+    pub i: u32,
+    pub j: u32,
+    pub shift: Vector3<f64>,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct NeighbourList {
+    skin: f64,
+    pub pairs: Vec<Pair>,
+    pub history: Vec<ContactHistory>,
+    /// Positions at the last build; rebuilding is due once a body has moved skin/2 from here.
+    reference: Vec<Vector3<f64>>,
+    /// Per body, the range of `entries` listing its pairs: entry = 2·pair + (0 for i, 1 for j).
+    offsets: Vec<u32>,
+    entries: Vec<u32>,
+    pub builds: u64,
+    #[serde(skip)]
+    scratch: Scratch,
+}
+
+#[derive(Debug, Clone, Default)]
+struct Scratch {
+    cell_start: Vec<u32>,
+    cell_bodies: Vec<u32>,
+    cell_of: Vec<usize>,
+    old_pairs: Vec<Pair>,
+    old_history: Vec<ContactHistory>,
+}
+
+/// The cell grid of one build: periodic directions with fewer than three cells collapse to one,
+/// so that the 27 neighbour cells of a cell are always distinct.
+struct Grid {
+    n: [usize; 3],
+    origin: Vector3<f64>,
+    width: Vector3<f64>,
+    periodic: bool,
+}
+
+impl Grid {
+    fn new(domain: &Domain, cutoff: f64, z_range: (f64, f64)) -> Self {
+        let l = domain.width();
+        let mut nxy = (l / cutoff).floor().max(1.0) as usize;
+        if domain.is_periodic() && nxy < 3 {
+            nxy = 1;
+        }
+        let height = (z_range.1 - z_range.0).max(cutoff);
+        let nz = (height / cutoff).floor().max(1.0) as usize;
+        Grid {
+            n: [nxy, nxy, nz],
+            origin: Vector3::new(0.0, 0.0, z_range.0),
+            width: Vector3::new(l / nxy as f64, l / nxy as f64, height / nz as f64),
+            periodic: domain.is_periodic(),
+        }
+    }
+
+    fn coordinates(&self, p: &Vector3<f64>) -> [usize; 3] {
+        let c = |k: usize| (((p[k] - self.origin[k]) / self.width[k]).floor().max(0.0) as usize).min(self.n[k] - 1);
+        [c(0), c(1), c(2)]
+    }
+
+    fn index(&self, c: [usize; 3]) -> usize {
+        (c[2] * self.n[1] + c[1]) * self.n[0] + c[0]
+    }
+
+    fn count(&self) -> usize {
+        self.n.iter().product()
+    }
+
+    /// The neighbour cell at offset `d` (−1, 0, 1 per axis), or None outside a non-periodic edge.
+    fn neighbour(&self, c: [usize; 3], d: [i64; 3]) -> Option<[usize; 3]> {
+        let mut out = [0; 3];
+        for k in 0..3 {
+            let n = self.n[k] as i64;
+            if n == 1 && d[k] != 0 {
+                return None;
+            }
+            let v = c[k] as i64 + d[k];
+            out[k] = if (0..n).contains(&v) {
+                v as usize
+            } else if self.periodic && k < 2 {
+                v.rem_euclid(n) as usize
+            } else {
+                return None;
+            };
+        }
+        Some(out)
+    }
+}
+
+impl NeighbourList {
+    pub fn new(skin: f64) -> Self {
+        Self {
+            skin,
+            pairs: Vec::new(),
+            history: Vec::new(),
+            reference: Vec::new(),
+            offsets: vec![0],
+            entries: Vec::new(),
+            builds: 0,
+            scratch: Scratch::default(),
+        }
+    }
+
+    pub fn skin(&self) -> f64 {
+        self.skin
+    }
+
+    /// A rebuild is due when bodies were added or one moved more than half the skin, the most
+    /// two bodies can approach each other without the list noticing.
+    pub fn is_stale(&self, bodies: &Bodies) -> bool {
+        if self.reference.len() != bodies.len() {
+            return true;
+        }
+        let limit = 0.25 * self.skin * self.skin;
+        bodies.position.iter().zip(&self.reference).any(|(p, r)| (p - r).norm_squared() > limit)
+    }
+
+    /// Pairs of body `b`, as entries 2·pair + side.
+    #[inline]
+    pub fn entries_of(&self, b: usize) -> &[u32] {
+        &self.entries[self.offsets[b] as usize..self.offsets[b + 1] as usize]
+    }
+
+    /// Wraps positions into the periodic box, bins bodies into cells, lists the pairs within
+    /// reach and carries each surviving pair's contact history over.
+    pub fn rebuild(&mut self, bodies: &mut Bodies, domain: &Domain) -> Result<(), SolverError> {
+        for p in &mut bodies.position {
+            domain.wrap(p);
+        }
+        let n = bodies.len();
+        let r_max = bodies.bounding_radius.iter().cloned().fold(0.0, f64::max);
+        let cutoff = 2.0 * r_max + self.skin;
+        if domain.is_periodic() && 2.0 * cutoff >= domain.width() {
+            return Err(SolverError::DomainTooNarrow { width: domain.width(), reach: cutoff });
+        }
+        let (z_lo, z_hi) =
+            bodies.position.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.z), hi.max(p.z)));
+        let grid = Grid::new(domain, cutoff, if n == 0 { (0.0, cutoff) } else { (z_lo, z_hi) });
+
+        // Counting sort of bodies into cells.
+        let s = &mut self.scratch;
+        s.cell_of.clear();
+        s.cell_of.extend(bodies.position.iter().map(|p| grid.index(grid.coordinates(p))));
+        s.cell_start.clear();
+        s.cell_start.resize(grid.count() + 1, 0);
+        for &c in &s.cell_of {
+            s.cell_start[c + 1] += 1;
+        }
+        for c in 0..grid.count() {
+            s.cell_start[c + 1] += s.cell_start[c];
+        }
+        s.cell_bodies.clear();
+        s.cell_bodies.resize(n, 0);
+        let mut fill = s.cell_start.clone();
+        for (b, &c) in s.cell_of.iter().enumerate() {
+            s.cell_bodies[fill[c] as usize] = b as u32;
+            fill[c] += 1;
+        }
+
+        std::mem::swap(&mut self.pairs, &mut s.old_pairs);
+        std::mem::swap(&mut self.history, &mut s.old_history);
+        self.pairs.clear();
+        for i in 0..n {
+            let xi = bodies.position[i];
+            let ci = grid.coordinates(&xi);
+            for dz in -1..=1 {
+                for dy in -1..=1 {
+                    for dx in -1..=1 {
+                        let Some(cj) = grid.neighbour(ci, [dx, dy, dz]) else { continue };
+                        let c = grid.index(cj);
+                        for &j in &s.cell_bodies[s.cell_start[c] as usize..s.cell_start[c + 1] as usize] {
+                            let j = j as usize;
+                            if j <= i {
+                                continue;
+                            }
+                            let shift = domain.image_shift(&xi, &bodies.position[j]);
+                            let reach = bodies.bounding_radius[i] + bodies.bounding_radius[j] + self.skin;
+                            if (bodies.position[j] + shift - xi).norm_squared() < reach * reach {
+                                self.pairs.push(Pair { i: i as u32, j: j as u32, shift });
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        self.pairs.sort_unstable_by_key(|p| (p.i, p.j));
+
+        // Merge by (i, j): both lists are sorted, so one pass carries the histories over.
+        self.history.clear();
+        let mut k = 0;
+        for p in &self.pairs {
+            while k < s.old_pairs.len() && (s.old_pairs[k].i, s.old_pairs[k].j) < (p.i, p.j) {
+                k += 1;
+            }
+            let same = k < s.old_pairs.len() && (s.old_pairs[k].i, s.old_pairs[k].j) == (p.i, p.j);
+            self.history.push(if same { s.old_history[k] } else { ContactHistory::default() });
+        }
+
+        self.offsets.clear();
+        self.offsets.resize(n + 1, 0);
+        for p in &self.pairs {
+            self.offsets[p.i as usize + 1] += 1;
+            self.offsets[p.j as usize + 1] += 1;
+        }
+        for b in 0..n {
+            self.offsets[b + 1] += self.offsets[b];
+        }
+        self.entries.clear();
+        self.entries.resize(2 * self.pairs.len(), 0);
+        let mut next: Vec<u32> = self.offsets[..n].to_vec();
+        for (k, p) in self.pairs.iter().enumerate() {
+            for (side, b) in [(0, p.i), (1, p.j)] {
+                self.entries[next[b as usize] as usize] = 2 * k as u32 + side;
+                next[b as usize] += 1;
+            }
+        }
+
+        self.reference.clear();
+        self.reference.extend_from_slice(&bodies.position);
+        self.builds += 1;
+        Ok(())
+    }
+}

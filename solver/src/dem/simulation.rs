@@ -1,0 +1,298 @@
+//! One DEM time step, read as the algorithm: neighbours → contacts → forces and integration.
+//! The packing protocol decides only which external forces apply (gravity and buoyancy, the
+//! shaking of Eq. 14, the damping of Eq. 15).
+
+use std::time::{Duration, Instant};
+
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::body::{Bodies, NewBody};
+use super::contact::{self, ContactGeometry};
+use super::contact_law::{Calibration, ContactHistory, LinearSpringDashpot};
+use super::domain::Domain;
+use super::neighbours::NeighbourList;
+use crate::SolverError;
+
+/// Time steps per collision below which the linear spring-dashpot is not resolved (the paper
+/// uses T_c/Δt = 40, §4.2).
+pub const MIN_STEPS_PER_COLLISION: f64 = 10.0;
+
+/// Overlap, relative to the smaller grain's smallest half-extent, beyond which the simulation is
+/// declared unstable rather than continued with a garbage result.
+pub const MAX_RELATIVE_OVERLAP: f64 = 0.5;
+
+/// Material and numerical constants of a simulation (§4.2).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Settings {
+    /// Grain density ρ_p (kg/m³).
+    pub density: f64,
+    /// Fluid density ρ_f (kg/m³); buoyancy reduces the weight to (ρ_p − ρ_f) V g (Eq. 10).
+    pub fluid_density: f64,
+    /// Gravitational acceleration vector (m/s²), (0, 0, −g) for the paper's setups.
+    pub gravity: Vector3<f64>,
+    pub restitution: f64,
+    pub collision_time: f64,
+    pub poisson_ratio: f64,
+    pub friction: f64,
+    pub time_step: f64,
+    /// Verlet skin of the neighbour list (m).
+    pub skin: f64,
+    /// How k_n and d_n follow from e_n and T_c.
+    pub calibration: Calibration,
+}
+
+/// Horizontal shaking force m A_s sin(2πt/T_s) (2π/T_s)² x̂, Eq. 14.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Shaking {
+    pub amplitude: f64,
+    pub period: f64,
+}
+
+impl Shaking {
+    /// Acceleration of Eq. 14 at time t.
+    pub fn acceleration(&self, t: f64) -> f64 {
+        let omega = 2.0 * std::f64::consts::PI / self.period;
+        self.amplitude * (omega * t).sin() * omega * omega
+    }
+}
+
+/// Force and torques of one pair contact: the force acts on body j, its opposite on body i,
+/// both at the contact point.
+#[derive(Debug, Clone, Copy, Default)]
+struct PairForce {
+    force: Vector3<f64>,
+    torque_i: Vector3<f64>,
+    torque_j: Vector3<f64>,
+}
+
+/// Wall-clock time spent in each stage since the simulation began.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct StageTimes {
+    pub neighbours: Duration,
+    pub contacts: Duration,
+    pub bodies: Duration,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Simulation {
+    pub bodies: Bodies,
+    pub domain: Domain,
+    pub settings: Settings,
+    law: LinearSpringDashpot,
+    neighbours: NeighbourList,
+    floor_history: Vec<ContactHistory>,
+    wall_history: Vec<ContactHistory>,
+    pub time: f64,
+    pub steps: u64,
+    /// Shaking force applied in the current phase, if any.
+    pub shaking: Option<Shaking>,
+    /// Damping coefficient c_d of Eq. 15 applied in the current phase, if any.
+    pub damping: Option<f64>,
+    /// Contacts (pair and wall) open in the last step.
+    pub contacts: usize,
+    #[serde(skip)]
+    pair_forces: Vec<PairForce>,
+    #[serde(skip)]
+    pub stage_times: StageTimes,
+}
+
+impl Simulation {
+    pub fn new(domain: Domain, settings: Settings) -> Result<Self, SolverError> {
+        if settings.collision_time / settings.time_step < MIN_STEPS_PER_COLLISION {
+            return Err(SolverError::TimeStepTooLarge {
+                time_step: settings.time_step,
+                collision_time: settings.collision_time,
+            });
+        }
+        Ok(Self {
+            bodies: Bodies::default(),
+            domain,
+            settings,
+            law: LinearSpringDashpot::new(
+                settings.restitution,
+                settings.collision_time,
+                settings.poisson_ratio,
+                settings.friction,
+                settings.calibration,
+            ),
+            neighbours: NeighbourList::new(settings.skin),
+            floor_history: Vec::new(),
+            wall_history: Vec::new(),
+            time: 0.0,
+            steps: 0,
+            shaking: None,
+            damping: None,
+            contacts: 0,
+            pair_forces: Vec::new(),
+            stage_times: StageTimes::default(),
+        })
+    }
+
+    pub fn law(&self) -> &LinearSpringDashpot {
+        &self.law
+    }
+
+    pub fn add_body(&mut self, body: NewBody) -> usize {
+        self.floor_history.push(ContactHistory::default());
+        self.wall_history.push(ContactHistory::default());
+        self.bodies.push(body, self.settings.density)
+    }
+
+    /// Advances the simulation by one time step Δt.
+    pub fn step(&mut self) -> Result<(), SolverError> {
+        let start = Instant::now();
+        if self.neighbours.is_stale(&self.bodies) {
+            self.neighbours.rebuild(&mut self.bodies, &self.domain)?;
+        }
+        let after_neighbours = Instant::now();
+        let (pair_contacts, worst_overlap) = self.pair_contacts();
+        let after_contacts = Instant::now();
+        if worst_overlap > MAX_RELATIVE_OVERLAP {
+            return Err(SolverError::Overlap { time: self.time, relative: worst_overlap });
+        }
+        let (wall_contacts, finite) = self.forces_and_integration();
+        let end = Instant::now();
+        if !finite {
+            return Err(SolverError::NotFinite { time: self.time });
+        }
+        self.contacts = pair_contacts + wall_contacts;
+        self.time += self.settings.time_step;
+        self.steps += 1;
+        self.stage_times.neighbours += after_neighbours - start;
+        self.stage_times.contacts += after_contacts - after_neighbours;
+        self.stage_times.bodies += end - after_contacts;
+        Ok(())
+    }
+
+    /// Narrow phase and contact law for every listed pair; returns the number of open contacts
+    /// and the largest overlap relative to the pair's smaller half-extent.
+    fn pair_contacts(&mut self) -> (usize, f64) {
+        let bodies = &self.bodies;
+        let law = &self.law;
+        let dt = self.settings.time_step;
+        self.pair_forces.resize(self.neighbours.pairs.len(), PairForce::default());
+        let pairs = &self.neighbours.pairs;
+        pairs
+            .par_iter()
+            .zip(self.neighbours.history.par_iter_mut())
+            .zip(self.pair_forces.par_iter_mut())
+            .map(|((pair, history), out)| {
+                let (i, j) = (pair.i as usize, pair.j as usize);
+                let xi = bodies.position[i];
+                let xj = bodies.position[j] + pair.shift;
+                let Some(geometry) = contact::between(&bodies.shape[i], &xi, &bodies.shape[j], &xj) else {
+                    *history = ContactHistory::default();
+                    *out = PairForce::default();
+                    return (0, 0.0);
+                };
+                let arm_i = geometry.point - xi;
+                let arm_j = geometry.point - xj;
+                let relative = bodies.point_velocity(j, &arm_j) - bodies.point_velocity(i, &arm_i);
+                let (mi, mj) = (bodies.mass[i], bodies.mass[j]);
+                let force = law.force(mi * mj / (mi + mj), &geometry, &relative, history, dt);
+                *out = PairForce { force, torque_i: force.cross(&arm_i), torque_j: arm_j.cross(&force) };
+                let scale = bodies.shape[i].smallest_half_extent().min(bodies.shape[j].smallest_half_extent());
+                (1, geometry.depth / scale)
+            })
+            .reduce(|| (0, 0.0), |a, b| (a.0 + b.0, a.1.max(b.1)))
+    }
+
+    /// Per body: wall contacts, the sum of its pair forces, external forces, then the
+    /// semi-implicit Euler update of §3.1 (velocities first, then position and rotation).
+    /// Returns the number of wall contacts and whether every state stayed finite.
+    fn forces_and_integration(&mut self) -> (usize, bool) {
+        let settings = &self.settings;
+        let law = &self.law;
+        let domain = self.domain;
+        let neighbours = &self.neighbours;
+        let pair_forces = &self.pair_forces;
+        let dt = settings.time_step;
+        let weight_per_volume = (settings.density - settings.fluid_density) * settings.gravity;
+        let shaking = self.shaking.map_or(0.0, |s| s.acceleration(self.time));
+        let damping = self.damping.map(|c| c.powf(dt));
+        let b = &mut self.bodies;
+        (
+            b.position.par_iter_mut(),
+            b.orientation.par_iter_mut(),
+            b.velocity.par_iter_mut(),
+            b.angular_velocity.par_iter_mut(),
+            self.floor_history.par_iter_mut(),
+            self.wall_history.par_iter_mut(),
+        )
+            .into_par_iter()
+            .enumerate()
+            .map(|(k, (x, q, v, w, floor, wall))| {
+                let shape = &b.shape[k];
+                let mass = b.mass[k];
+                let mut force = weight_per_volume * b.volume[k] + Vector3::new(mass * shaking, 0.0, 0.0);
+                let mut torque = Vector3::zeros();
+                for &entry in neighbours.entries_of(k) {
+                    let pf = &pair_forces[(entry / 2) as usize];
+                    if entry % 2 == 0 {
+                        force -= pf.force;
+                        torque += pf.torque_i;
+                    } else {
+                        force += pf.force;
+                        torque += pf.torque_j;
+                    }
+                }
+                let mut wall_contacts = 0;
+                let walls =
+                    [(contact::with_floor(shape, x), &mut *floor), (contact::with_wall(shape, x, &domain), &mut *wall)];
+                for (geometry, history) in walls {
+                    match geometry {
+                        Some(g) => {
+                            // The wall is body B, immovable: m_eff = m and its velocity is zero.
+                            let arm = g.point - *x;
+                            let relative = -(*v + w.cross(&arm));
+                            let f = -law.force(mass, &g, &relative, history, dt);
+                            force += f;
+                            torque += arm.cross(&f);
+                            wall_contacts += 1;
+                        }
+                        None => *history = ContactHistory::default(),
+                    }
+                }
+
+                *v += force * (dt / mass);
+                let inertia = b.inertia[k];
+                if inertia.x == inertia.y && inertia.y == inertia.z {
+                    *w += torque * (dt / inertia.x);
+                } else {
+                    // Euler's equations I ω̇ = T − ω × I ω in the body frame of the current
+                    // orientation, i.e. with the world-frame inertia R diag(I) Rᵀ.
+                    let body_w = q.inverse_transform_vector(w);
+                    let body_t = q.inverse_transform_vector(&torque);
+                    let body_wdot = (body_t - body_w.cross(&body_w.component_mul(&inertia))).component_div(&inertia);
+                    *w += q.transform_vector(&body_wdot) * dt;
+                }
+                *x += *v * dt;
+                // q ← q + ½ Δt (0, ω) q, renormalised: exact to O((|ω|Δt)³) per step.
+                let dq = Quaternion::from_imag(*w * (0.5 * dt)) * q.quaternion();
+                *q = UnitQuaternion::new_normalize(q.quaternion() + dq);
+                if let Some(c) = damping {
+                    *v *= c;
+                    *w *= c;
+                }
+                // The sum is finite exactly when every component is (NaN and ±∞ propagate).
+                (wall_contacts, (x.sum() + v.sum() + w.sum()).is_finite())
+            })
+            .reduce(|| (0, true), |a, b| (a.0 + b.0, a.1 && b.1))
+    }
+
+    /// Mass-averaged height ⟨z⟩ = Σ m z / Σ m (§4.3).
+    pub fn mean_height(&self) -> f64 {
+        let b = &self.bodies;
+        let total: f64 = b.mass.iter().sum();
+        b.mass.iter().zip(&b.position).map(|(m, x)| m * x.z).sum::<f64>() / total
+    }
+
+    /// The exact contact of two bodies as the narrow phase sees it, for inspection and tests.
+    pub fn body_contact(&self, i: usize, j: usize) -> Option<ContactGeometry> {
+        let b = &self.bodies;
+        let shift = self.domain.image_shift(&b.position[i], &b.position[j]);
+        contact::between(&b.shape[i], &b.position[i], &b.shape[j], &(b.position[j] + shift))
+    }
+}

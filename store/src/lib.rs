@@ -1,0 +1,486 @@
+//! sedpack's SQLite store: campaigns, the job queue, results, grain statistics and checkpoints.
+//!
+//! The store knows nothing of DEM or YAML: a job's spec and parameters are opaque JSON to it.
+//! Several processes may share one database file: every state change is one statement or one
+//! write transaction, and a job changes hands only through [`Store::claim`]. Timestamps are UNIX
+//! seconds from the clock of the process that writes them.
+
+mod error;
+mod open;
+mod sql;
+mod types;
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, SystemTime, UNIX_EPOCH};
+
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+use sqlx::sqlite::{SqliteConnectOptions, SqliteConnection, SqlitePool, SqlitePoolOptions, SqliteSynchronous};
+
+pub use error::StoreError;
+pub use types::{
+    Campaign, CampaignStatus, Checkpoint, ClaimedJob, ExportRow, Failure, GrainStatistic, JobResult, JobState, NewJob,
+    ProfilePoint, RunningJob,
+};
+
+/// How long a statement waits for another connection's lock before it fails.
+const BUSY_TIMEOUT: Duration = Duration::from_secs(30);
+const POOL_SIZE: u32 = 4;
+
+/// An open sedpack database; cheap to clone, all clones share one connection pool.
+#[derive(Debug, Clone)]
+pub struct Store {
+    pool: SqlitePool,
+    path: PathBuf,
+}
+
+impl Store {
+    /// Opens the sedpack database at `path`, creating it if missing and updating its schema.
+    /// Refuses, leaving them unchanged, files that are not SQLite and other applications' databases.
+    pub async fn open(path: impl AsRef<Path>) -> Result<Store, StoreError> {
+        let path = path.as_ref().to_path_buf();
+        let options = SqliteConnectOptions::new()
+            .filename(&path)
+            .foreign_keys(true)
+            .busy_timeout(BUSY_TIMEOUT)
+            // A committed result survives a power cut.
+            .synchronous(SqliteSynchronous::Full);
+        open::prepare(&path, &options, BUSY_TIMEOUT).await?;
+        let pool = SqlitePoolOptions::new()
+            .max_connections(POOL_SIZE)
+            .connect_with(options)
+            .await
+            .map_err(|source| StoreError::Database { path: path.clone(), source })?;
+        Ok(Store { pool, path })
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Waits for running statements and closes every connection.
+    pub async fn close(self) {
+        self.pool.close().await;
+    }
+
+    /// Records a campaign, or replaces the spec of the campaign of that name.
+    pub async fn upsert_campaign(&self, name: &str, spec: &str) -> Result<(), StoreError> {
+        sqlx::query(sql::UPSERT_CAMPAIGN)
+            .bind(name)
+            .bind(spec)
+            .bind(now())
+            .execute(&self.pool)
+            .await
+            .map_err(self.db())?;
+        Ok(())
+    }
+
+    pub async fn campaign(&self, name: &str) -> Result<Campaign, StoreError> {
+        let row: Option<(String, String, f64, f64)> =
+            sqlx::query_as(sql::CAMPAIGN).bind(name).fetch_optional(&self.pool).await.map_err(self.db())?;
+        let (name, spec, created_at, updated_at) = row.ok_or_else(|| self.no_campaign(name))?;
+        Ok(Campaign { name, spec, created_at, updated_at })
+    }
+
+    pub async fn campaigns(&self) -> Result<Vec<Campaign>, StoreError> {
+        let rows: Vec<(String, String, f64, f64)> =
+            sqlx::query_as(sql::CAMPAIGNS).fetch_all(&self.pool).await.map_err(self.db())?;
+        Ok(rows
+            .into_iter()
+            .map(|(name, spec, created_at, updated_at)| Campaign { name, spec, created_at, updated_at })
+            .collect())
+    }
+
+    /// Adds the jobs whose id is new and returns how many were; known ids are left as they are.
+    /// An id that belongs to another campaign is an error and nothing is added.
+    pub async fn add_jobs(&self, campaign: &str, jobs: &[NewJob]) -> Result<u64, StoreError> {
+        let mut tx = self.pool.begin_with(sql::BEGIN_IMMEDIATE).await.map_err(self.db())?;
+        let campaign_id = self.campaign_id(&mut tx, campaign).await?;
+        let now = now();
+        let mut added = 0;
+        for job in jobs {
+            let inserted = sqlx::query(sql::INSERT_JOB)
+                .bind(&job.id)
+                .bind(campaign_id)
+                .bind(self.encode_json(&job.spec, &format!("spec of job {}", job.id))?)
+                .bind(self.to_sql_int(job.seed, &format!("seed of job {}", job.id))?)
+                .bind(self.encode_json(&job.parameters, &format!("parameters of job {}", job.id))?)
+                .bind(now)
+                .execute(&mut *tx)
+                .await
+                .map_err(self.db())?
+                .rows_affected();
+            if inserted == 0 {
+                let owner: String =
+                    sqlx::query_scalar(sql::JOB_CAMPAIGN).bind(&job.id).fetch_one(&mut *tx).await.map_err(self.db())?;
+                if owner != campaign {
+                    return Err(self.invalid(format!(
+                        "job {} already belongs to campaign {owner:?}, not {campaign:?}: job ids \
+                         must be unique across campaigns",
+                        job.id
+                    )));
+                }
+            }
+            added += inserted;
+        }
+        tx.commit().await.map_err(self.db())?;
+        Ok(added)
+    }
+
+    /// Hands the campaign's next pending job (in submission order) to `worker_id`, or None if no
+    /// job is pending. No two claimers, in this process or another, ever get the same job.
+    pub async fn claim(&self, campaign: &str, worker_id: &str) -> Result<Option<ClaimedJob>, StoreError> {
+        let mut conn = self.pool.acquire().await.map_err(self.db())?;
+        let campaign_id = self.campaign_id(&mut conn, campaign).await?;
+        // One UPDATE … RETURNING takes the write lock before it reads, so the pick is atomic.
+        let row: Option<(String, String, u64, String, u32)> = sqlx::query_as(sql::CLAIM_JOB)
+            .bind(campaign_id)
+            .bind(worker_id)
+            .bind(now())
+            .fetch_optional(&mut *conn)
+            .await
+            .map_err(self.db())?;
+        let Some((id, spec, seed, parameters, attempts)) = row else {
+            return Ok(None);
+        };
+        Ok(Some(ClaimedJob {
+            spec: self.decode_json(&spec, &format!("spec of job {id}"))?,
+            parameters: self.decode_json(&parameters, &format!("parameters of job {id}"))?,
+            id,
+            seed,
+            attempts,
+        }))
+    }
+
+    /// Tells the store that `worker_id` is still working on the job.
+    /// Fails with [`StoreError::NotOwner`] if the job was taken away, so the worker can stop.
+    pub async fn heartbeat(&self, job_id: &str, worker_id: &str) -> Result<(), StoreError> {
+        let updated = sqlx::query(sql::HEARTBEAT)
+            .bind(job_id)
+            .bind(worker_id)
+            .bind(now())
+            .execute(&self.pool)
+            .await
+            .map_err(self.db())?
+            .rows_affected();
+        self.owned(updated, job_id, worker_id)
+    }
+
+    /// Marks the job done with its result and grain statistics, all or nothing, and drops its
+    /// checkpoint. Fails with [`StoreError::NotOwner`], writing nothing, unless the job is still
+    /// running for `worker_id`.
+    pub async fn complete(
+        &self,
+        job_id: &str,
+        worker_id: &str,
+        result: &JobResult,
+        statistics: &[GrainStatistic],
+    ) -> Result<(), StoreError> {
+        let profile = self.encode_json(&result.profile, &format!("profile of job {job_id}"))?;
+        let particles = self.to_sql_int(result.particles, &format!("particles of job {job_id}"))?;
+        let steps = self.to_sql_int(result.steps, &format!("steps of job {job_id}"))?;
+        let now = now();
+        let mut tx = self.pool.begin_with(sql::BEGIN_IMMEDIATE).await.map_err(self.db())?;
+        let finished = sqlx::query(sql::FINISH_JOB)
+            .bind(job_id)
+            .bind(worker_id)
+            .bind(now)
+            .execute(&mut *tx)
+            .await
+            .map_err(self.db())?
+            .rows_affected();
+        self.owned(finished, job_id, worker_id)?;
+        sqlx::query(sql::INSERT_RESULT)
+            .bind(job_id)
+            .bind(result.porosity)
+            .bind(result.z_minus)
+            .bind(result.z_plus)
+            .bind(profile)
+            .bind(particles)
+            .bind(result.simulated_time)
+            .bind(steps)
+            .bind(result.wall_time)
+            .bind(&result.solver_version)
+            .bind(now)
+            .execute(&mut *tx)
+            .await
+            .map_err(self.db())?;
+        for statistic in statistics {
+            sqlx::query(sql::INSERT_GRAIN_STATISTIC)
+                .bind(job_id)
+                .bind(&statistic.name)
+                .bind(statistic.mean)
+                .bind(statistic.std)
+                .execute(&mut *tx)
+                .await
+                .map_err(self.db())?;
+        }
+        sqlx::query(sql::DELETE_CHECKPOINT).bind(job_id).execute(&mut *tx).await.map_err(self.db())?;
+        tx.commit().await.map_err(self.db())
+    }
+
+    /// Marks the job failed with its error text and drops its checkpoint, so that a retry starts
+    /// afresh rather than from the state that failed. Same ownership rule as [`Store::complete`].
+    pub async fn fail(&self, job_id: &str, worker_id: &str, error: &str) -> Result<(), StoreError> {
+        let mut tx = self.pool.begin_with(sql::BEGIN_IMMEDIATE).await.map_err(self.db())?;
+        let failed = sqlx::query(sql::FAIL_JOB)
+            .bind(job_id)
+            .bind(worker_id)
+            .bind(error)
+            .bind(now())
+            .execute(&mut *tx)
+            .await
+            .map_err(self.db())?
+            .rows_affected();
+        self.owned(failed, job_id, worker_id)?;
+        sqlx::query(sql::DELETE_CHECKPOINT).bind(job_id).execute(&mut *tx).await.map_err(self.db())?;
+        tx.commit().await.map_err(self.db())
+    }
+
+    /// Returns the job to pending if it is still running for `worker_id`: a worker's own job on
+    /// Ctrl-C, or the job of a worker the caller knows is gone. Its checkpoint stays, attempts
+    /// keep counting. Returns false, changing nothing, if the job had already changed hands.
+    pub async fn release(&self, job_id: &str, worker_id: &str) -> Result<bool, StoreError> {
+        let released = sqlx::query(sql::RELEASE_JOB)
+            .bind(job_id)
+            .bind(worker_id)
+            .execute(&self.pool)
+            .await
+            .map_err(self.db())?
+            .rows_affected();
+        Ok(released == 1)
+    }
+
+    /// The campaign's running jobs with their workers and heartbeats.
+    pub async fn running_jobs(&self, campaign: &str) -> Result<Vec<RunningJob>, StoreError> {
+        let mut conn = self.pool.acquire().await.map_err(self.db())?;
+        let campaign_id = self.campaign_id(&mut conn, campaign).await?;
+        let rows: Vec<(String, String, u32, f64, f64)> =
+            sqlx::query_as(sql::RUNNING_JOBS).bind(campaign_id).fetch_all(&mut *conn).await.map_err(self.db())?;
+        Ok(rows
+            .into_iter()
+            .map(|(job_id, worker_id, attempts, started_at, heartbeat_at)| RunningJob {
+                job_id,
+                worker_id,
+                attempts,
+                started_at,
+                heartbeat_at,
+            })
+            .collect())
+    }
+
+    /// Returns to pending every running job of the campaign whose last heartbeat is older than
+    /// `older_than`, and gives their ids.
+    pub async fn requeue_stale(&self, campaign: &str, older_than: Duration) -> Result<Vec<String>, StoreError> {
+        let mut conn = self.pool.acquire().await.map_err(self.db())?;
+        let campaign_id = self.campaign_id(&mut conn, campaign).await?;
+        sqlx::query_scalar(sql::REQUEUE_STALE)
+            .bind(campaign_id)
+            .bind(now() - older_than.as_secs_f64())
+            .fetch_all(&mut *conn)
+            .await
+            .map_err(self.db())
+    }
+
+    /// Returns the campaign's failed jobs to pending, clearing their errors; gives how many.
+    pub async fn requeue_failed(&self, campaign: &str) -> Result<u64, StoreError> {
+        let mut conn = self.pool.acquire().await.map_err(self.db())?;
+        let campaign_id = self.campaign_id(&mut conn, campaign).await?;
+        let requeued = sqlx::query(sql::REQUEUE_FAILED)
+            .bind(campaign_id)
+            .execute(&mut *conn)
+            .await
+            .map_err(self.db())?
+            .rows_affected();
+        Ok(requeued)
+    }
+
+    /// Saves (replacing any earlier one) the job's checkpoint; counts as a heartbeat.
+    /// Fails with [`StoreError::NotOwner`], writing nothing, unless the job is running for `worker_id`.
+    pub async fn save_checkpoint(
+        &self,
+        job_id: &str,
+        worker_id: &str,
+        data: &[u8],
+        simulated_time: f64,
+    ) -> Result<(), StoreError> {
+        let now = now();
+        let mut tx = self.pool.begin_with(sql::BEGIN_IMMEDIATE).await.map_err(self.db())?;
+        let updated = sqlx::query(sql::HEARTBEAT)
+            .bind(job_id)
+            .bind(worker_id)
+            .bind(now)
+            .execute(&mut *tx)
+            .await
+            .map_err(self.db())?
+            .rows_affected();
+        self.owned(updated, job_id, worker_id)?;
+        sqlx::query(sql::UPSERT_CHECKPOINT)
+            .bind(job_id)
+            .bind(data)
+            .bind(simulated_time)
+            .bind(now)
+            .execute(&mut *tx)
+            .await
+            .map_err(self.db())?;
+        tx.commit().await.map_err(self.db())
+    }
+
+    pub async fn load_checkpoint(&self, job_id: &str) -> Result<Option<Checkpoint>, StoreError> {
+        let row: Option<(Vec<u8>, f64, f64)> =
+            sqlx::query_as(sql::LOAD_CHECKPOINT).bind(job_id).fetch_optional(&self.pool).await.map_err(self.db())?;
+        Ok(row.map(|(data, simulated_time, written_at)| Checkpoint { data, simulated_time, written_at }))
+    }
+
+    /// Deletes the job's checkpoint; returns whether there was one.
+    pub async fn delete_checkpoint(&self, job_id: &str) -> Result<bool, StoreError> {
+        let deleted = sqlx::query(sql::DELETE_CHECKPOINT)
+            .bind(job_id)
+            .execute(&self.pool)
+            .await
+            .map_err(self.db())?
+            .rows_affected();
+        Ok(deleted == 1)
+    }
+
+    /// Counts per state, the failures with their errors and the wall times, from one snapshot.
+    pub async fn status(&self, campaign: &str) -> Result<CampaignStatus, StoreError> {
+        let mut tx = self.pool.begin().await.map_err(self.db())?;
+        let campaign_id = self.campaign_id(&mut tx, campaign).await?;
+        let (jobs, pending, running, done, failed, wall_time_finished, mean_wall_time_done): (
+            u64,
+            u64,
+            u64,
+            u64,
+            u64,
+            f64,
+            Option<f64>,
+        ) = sqlx::query_as(sql::STATUS_COUNTS).bind(campaign_id).fetch_one(&mut *tx).await.map_err(self.db())?;
+        let failures: Vec<(String, u32, String)> =
+            sqlx::query_as(sql::FAILURES).bind(campaign_id).fetch_all(&mut *tx).await.map_err(self.db())?;
+        tx.commit().await.map_err(self.db())?;
+        Ok(CampaignStatus {
+            campaign: campaign.to_string(),
+            jobs,
+            pending,
+            running,
+            done,
+            failed,
+            failures: failures
+                .into_iter()
+                .map(|(job_id, attempts, error)| Failure { job_id, attempts, error })
+                .collect(),
+            wall_time_finished,
+            mean_wall_time_done,
+        })
+    }
+
+    /// Every job of the campaign in submission order, with its result and grain statistics,
+    /// from one snapshot.
+    pub async fn export(&self, campaign: &str) -> Result<Vec<ExportRow>, StoreError> {
+        type JobRow = (String, String, u64, u32, Option<String>, String, String);
+        type ResultRow = (String, f64, f64, f64, String, u64, f64, u64, f64, String);
+        let mut tx = self.pool.begin().await.map_err(self.db())?;
+        let campaign_id = self.campaign_id(&mut tx, campaign).await?;
+        let jobs: Vec<JobRow> =
+            sqlx::query_as(sql::EXPORT_JOBS).bind(campaign_id).fetch_all(&mut *tx).await.map_err(self.db())?;
+        let results: Vec<ResultRow> =
+            sqlx::query_as(sql::EXPORT_RESULTS).bind(campaign_id).fetch_all(&mut *tx).await.map_err(self.db())?;
+        let statistics: Vec<(String, String, f64, f64)> = sqlx::query_as(sql::EXPORT_GRAIN_STATISTICS)
+            .bind(campaign_id)
+            .fetch_all(&mut *tx)
+            .await
+            .map_err(self.db())?;
+        tx.commit().await.map_err(self.db())?;
+
+        let mut results_by_job = HashMap::new();
+        for (job_id, porosity, z_minus, z_plus, profile, particles, simulated_time, steps, wall_time, solver_version) in
+            results
+        {
+            let profile = self.decode_json(&profile, &format!("profile of job {job_id}"))?;
+            let result = JobResult {
+                porosity,
+                z_minus,
+                z_plus,
+                profile,
+                particles,
+                simulated_time,
+                steps,
+                wall_time,
+                solver_version,
+            };
+            results_by_job.insert(job_id, result);
+        }
+        let mut statistics_by_job: HashMap<String, Vec<GrainStatistic>> = HashMap::new();
+        for (job_id, name, mean, std) in statistics {
+            statistics_by_job.entry(job_id).or_default().push(GrainStatistic { name, mean, std });
+        }
+        jobs.into_iter()
+            .map(|(job_id, state, seed, attempts, error, parameters, spec)| {
+                Ok(ExportRow {
+                    state: JobState::parse(&state)
+                        .ok_or_else(|| self.invalid(format!("job {job_id} has the unknown state {state:?}")))?,
+                    seed,
+                    attempts,
+                    error,
+                    parameters: self.decode_json(&parameters, &format!("parameters of job {job_id}"))?,
+                    spec: self.decode_json(&spec, &format!("spec of job {job_id}"))?,
+                    result: results_by_job.remove(&job_id),
+                    grain_statistics: statistics_by_job.remove(&job_id).unwrap_or_default(),
+                    job_id,
+                })
+            })
+            .collect()
+    }
+
+    async fn campaign_id(&self, conn: &mut SqliteConnection, name: &str) -> Result<i64, StoreError> {
+        let id: Option<i64> =
+            sqlx::query_scalar(sql::CAMPAIGN_ID).bind(name).fetch_optional(conn).await.map_err(self.db())?;
+        id.ok_or_else(|| self.no_campaign(name))
+    }
+
+    /// Turns "the ownership-checked UPDATE touched no row" into [`StoreError::NotOwner`].
+    fn owned(&self, updated: u64, job_id: &str, worker_id: &str) -> Result<(), StoreError> {
+        if updated == 1 {
+            Ok(())
+        } else {
+            Err(StoreError::NotOwner {
+                path: self.path.clone(),
+                job_id: job_id.to_string(),
+                worker_id: worker_id.to_string(),
+            })
+        }
+    }
+
+    fn db(&self) -> impl Fn(sqlx::Error) -> StoreError + '_ {
+        |source| StoreError::Database { path: self.path.clone(), source }
+    }
+
+    fn invalid(&self, detail: String) -> StoreError {
+        StoreError::Invalid { path: self.path.clone(), detail }
+    }
+
+    fn no_campaign(&self, name: &str) -> StoreError {
+        StoreError::NoCampaign { path: self.path.clone(), name: name.to_string() }
+    }
+
+    fn encode_json(&self, value: &impl Serialize, what: &str) -> Result<String, StoreError> {
+        serde_json::to_string(value).map_err(|e| self.invalid(format!("{what}: {e}")))
+    }
+
+    fn decode_json<T: DeserializeOwned>(&self, text: &str, what: &str) -> Result<T, StoreError> {
+        serde_json::from_str(text).map_err(|e| self.invalid(format!("{what} is unreadable: {e}")))
+    }
+
+    /// SQLite integers are signed 64-bit.
+    fn to_sql_int(&self, value: u64, what: &str) -> Result<i64, StoreError> {
+        i64::try_from(value)
+            .map_err(|_| self.invalid(format!("{what} = {value} exceeds 2^63 - 1, the largest SQLite integer")))
+    }
+}
+
+/// UNIX seconds from this process's clock.
+fn now() -> f64 {
+    SystemTime::now().duration_since(UNIX_EPOCH).unwrap_or_default().as_secs_f64()
+}

@@ -1,0 +1,100 @@
+//! Every SQL statement of the store, as plain strings with numbered parameters.
+
+// Opening
+pub const APPLICATION_ID: &str = "PRAGMA application_id";
+pub const USER_TABLES: &str = "
+    SELECT name FROM sqlite_schema
+    WHERE type IN ('table', 'view') AND name NOT LIKE 'sqlite\\_%' ESCAPE '\\' ORDER BY name";
+pub const JOURNAL_MODE_WAL: &str = "PRAGMA journal_mode = WAL";
+pub const BEGIN_IMMEDIATE: &str = "BEGIN IMMEDIATE";
+
+// Campaigns
+pub const UPSERT_CAMPAIGN: &str = "
+    INSERT INTO campaigns (name, spec, created_at, updated_at) VALUES (?1, ?2, ?3, ?3)
+    ON CONFLICT (name) DO UPDATE SET spec = excluded.spec, updated_at = excluded.updated_at";
+pub const CAMPAIGN_ID: &str = "SELECT id FROM campaigns WHERE name = ?1";
+pub const CAMPAIGN: &str = "SELECT name, spec, created_at, updated_at FROM campaigns WHERE name = ?1";
+pub const CAMPAIGNS: &str = "SELECT name, spec, created_at, updated_at FROM campaigns ORDER BY created_at, name";
+
+// Jobs
+pub const INSERT_JOB: &str = "
+    INSERT INTO jobs (id, campaign_id, spec, seed, parameters, created_at)
+    VALUES (?1, ?2, ?3, ?4, ?5, ?6)
+    ON CONFLICT (id) DO NOTHING";
+pub const JOB_CAMPAIGN: &str = "
+    SELECT campaigns.name FROM jobs JOIN campaigns ON campaigns.id = jobs.campaign_id
+    WHERE jobs.id = ?1";
+pub const CLAIM_JOB: &str = "
+    UPDATE jobs
+    SET state = 'running', attempts = attempts + 1, worker_id = ?2,
+        started_at = ?3, heartbeat_at = ?3, finished_at = NULL, wall_time = NULL, error = NULL
+    WHERE state = 'pending' AND id = (
+        SELECT id FROM jobs WHERE campaign_id = ?1 AND state = 'pending' ORDER BY rowid LIMIT 1)
+    RETURNING id, spec, seed, parameters, attempts";
+pub const HEARTBEAT: &str = "
+    UPDATE jobs SET heartbeat_at = ?3
+    WHERE id = ?1 AND worker_id = ?2 AND state = 'running'";
+pub const FINISH_JOB: &str = "
+    UPDATE jobs SET state = 'done', heartbeat_at = ?3, finished_at = ?3, wall_time = ?3 - started_at
+    WHERE id = ?1 AND worker_id = ?2 AND state = 'running'";
+pub const FAIL_JOB: &str = "
+    UPDATE jobs
+    SET state = 'failed', error = ?3, heartbeat_at = ?4, finished_at = ?4, wall_time = ?4 - started_at
+    WHERE id = ?1 AND worker_id = ?2 AND state = 'running'";
+pub const RELEASE_JOB: &str = "
+    UPDATE jobs SET state = 'pending', worker_id = NULL, heartbeat_at = NULL, started_at = NULL
+    WHERE id = ?1 AND worker_id = ?2 AND state = 'running'";
+pub const REQUEUE_STALE: &str = "
+    UPDATE jobs SET state = 'pending', worker_id = NULL, heartbeat_at = NULL, started_at = NULL
+    WHERE campaign_id = ?1 AND state = 'running' AND heartbeat_at < ?2
+    RETURNING id";
+pub const REQUEUE_FAILED: &str = "
+    UPDATE jobs
+    SET state = 'pending', error = NULL, worker_id = NULL, heartbeat_at = NULL,
+        started_at = NULL, finished_at = NULL, wall_time = NULL
+    WHERE campaign_id = ?1 AND state = 'failed'";
+pub const RUNNING_JOBS: &str = "
+    SELECT id, worker_id, attempts, started_at, heartbeat_at FROM jobs
+    WHERE campaign_id = ?1 AND state = 'running' ORDER BY rowid";
+
+// Results
+pub const INSERT_RESULT: &str = "
+    INSERT INTO results (job_id, porosity, z_minus, z_plus, profile, particles, simulated_time,
+                         steps, wall_time, solver_version, created_at)
+    VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11)";
+pub const INSERT_GRAIN_STATISTIC: &str =
+    "INSERT INTO grain_statistics (job_id, name, mean, std) VALUES (?1, ?2, ?3, ?4)";
+
+// Checkpoints
+pub const UPSERT_CHECKPOINT: &str = "
+    INSERT INTO checkpoints (job_id, data, simulated_time, written_at) VALUES (?1, ?2, ?3, ?4)
+    ON CONFLICT (job_id) DO UPDATE
+    SET data = excluded.data, simulated_time = excluded.simulated_time, written_at = excluded.written_at";
+pub const LOAD_CHECKPOINT: &str = "SELECT data, simulated_time, written_at FROM checkpoints WHERE job_id = ?1";
+pub const DELETE_CHECKPOINT: &str = "DELETE FROM checkpoints WHERE job_id = ?1";
+
+// Status and export
+pub const STATUS_COUNTS: &str = "
+    SELECT COUNT(*),
+           COUNT(*) FILTER (WHERE state = 'pending'),
+           COUNT(*) FILTER (WHERE state = 'running'),
+           COUNT(*) FILTER (WHERE state = 'done'),
+           COUNT(*) FILTER (WHERE state = 'failed'),
+           TOTAL(wall_time) FILTER (WHERE state IN ('done', 'failed')),
+           AVG(wall_time) FILTER (WHERE state = 'done')
+    FROM jobs WHERE campaign_id = ?1";
+pub const FAILURES: &str = "
+    SELECT id, attempts, error FROM jobs
+    WHERE campaign_id = ?1 AND state = 'failed' ORDER BY rowid";
+pub const EXPORT_JOBS: &str = "
+    SELECT id, state, seed, attempts, error, parameters, spec FROM jobs
+    WHERE campaign_id = ?1 ORDER BY rowid";
+pub const EXPORT_RESULTS: &str = "
+    SELECT results.job_id, porosity, z_minus, z_plus, profile, particles, simulated_time, steps,
+           results.wall_time, solver_version
+    FROM results JOIN jobs ON jobs.id = results.job_id
+    WHERE jobs.campaign_id = ?1";
+pub const EXPORT_GRAIN_STATISTICS: &str = "
+    SELECT grain_statistics.job_id, name, mean, std
+    FROM grain_statistics JOIN jobs ON jobs.id = grain_statistics.job_id
+    WHERE jobs.campaign_id = ?1 ORDER BY grain_statistics.rowid";

@@ -1,0 +1,149 @@
+//! The values that go in and out of the store. Specs and parameters are opaque JSON to it.
+
+use serde::{Deserialize, Serialize};
+use serde_json::{Map, Value};
+
+/// A job's place in the queue: pending → running → done | failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum JobState {
+    Pending,
+    Running,
+    Done,
+    Failed,
+}
+
+impl JobState {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            JobState::Pending => "pending",
+            JobState::Running => "running",
+            JobState::Done => "done",
+            JobState::Failed => "failed",
+        }
+    }
+
+    pub(crate) fn parse(text: &str) -> Option<JobState> {
+        [JobState::Pending, JobState::Running, JobState::Done, JobState::Failed]
+            .into_iter()
+            .find(|state| state.as_str() == text)
+    }
+}
+
+/// A campaign as submitted: its name and the campaign file's text.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Campaign {
+    pub name: String,
+    pub spec: String,
+    pub created_at: f64,
+    pub updated_at: f64,
+}
+
+/// A job to add to a campaign.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NewJob {
+    /// Stable hash of the resolved spec; unique across all campaigns of the database.
+    pub id: String,
+    pub spec: Value,
+    pub seed: u64,
+    /// Grid key (dotted) → the value this job takes.
+    pub parameters: Map<String, Value>,
+}
+
+/// A job handed to a worker by [`crate::Store::claim`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ClaimedJob {
+    pub id: String,
+    pub spec: Value,
+    pub seed: u64,
+    pub parameters: Map<String, Value>,
+    /// How many times the job has been claimed, this time included.
+    pub attempts: u32,
+}
+
+/// Porosity of one slice; `z` is the slice centre in m.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ProfilePoint {
+    pub z: f64,
+    pub n: f64,
+}
+
+/// What a finished packing reports.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct JobResult {
+    pub porosity: f64,
+    pub z_minus: f64,
+    pub z_plus: f64,
+    pub profile: Vec<ProfilePoint>,
+    pub particles: u64,
+    /// s of simulated time.
+    pub simulated_time: f64,
+    pub steps: u64,
+    /// s of wall-clock time, as measured by the runner.
+    pub wall_time: f64,
+    pub solver_version: String,
+}
+
+/// Number-based mean and std of one form factor ("FL") or its inverse ("inv_FL") over a job's grains.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GrainStatistic {
+    pub name: String,
+    pub mean: f64,
+    pub std: f64,
+}
+
+/// A job's saved solver state, opaque to the store.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Checkpoint {
+    pub data: Vec<u8>,
+    pub simulated_time: f64,
+    pub written_at: f64,
+}
+
+/// A job some worker holds, for deciding whether that worker is still alive.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunningJob {
+    pub job_id: String,
+    pub worker_id: String,
+    pub attempts: u32,
+    pub started_at: f64,
+    pub heartbeat_at: f64,
+}
+
+/// A failed job and its error text.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Failure {
+    pub job_id: String,
+    pub attempts: u32,
+    pub error: String,
+}
+
+/// Counts per state and the timings an ETA needs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CampaignStatus {
+    pub campaign: String,
+    pub jobs: u64,
+    pub pending: u64,
+    pub running: u64,
+    pub done: u64,
+    pub failed: u64,
+    pub failures: Vec<Failure>,
+    /// s of wall-clock time of the last attempt of every done or failed job, summed.
+    pub wall_time_finished: f64,
+    /// s per done job (last attempt), None before the first one is done.
+    pub mean_wall_time_done: Option<f64>,
+}
+
+/// One job of an export, with its result and grain statistics if it is done.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ExportRow {
+    pub job_id: String,
+    pub state: JobState,
+    pub seed: u64,
+    pub attempts: u32,
+    pub error: Option<String>,
+    pub parameters: Map<String, Value>,
+    pub spec: Value,
+    pub result: Option<JobResult>,
+    pub grain_statistics: Vec<GrainStatistic>,
+}

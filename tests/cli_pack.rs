@@ -1,0 +1,137 @@
+//! End-to-end tests of `sedpack pack` and `sedpack porosity`, running the built binary.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn sedpack(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sedpack")).args(args).output().expect("sedpack runs")
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+/// The command fails with status 1 and one line on stderr containing every needle.
+fn fails(args: &[&str], needles: &[&str]) {
+    let out = sedpack(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+    assert_eq!(stderr.trim_end().lines().count(), 1, "one line: {stderr}");
+    for n in needles {
+        assert!(stderr.contains(n), "'{stderr}' lacks '{n}'");
+    }
+}
+
+const SMALL_BED: &str = "name: small
+domain: {kind: periodic, width: 0.04, height: 0.15}
+grains:
+  shape: sphere
+  size: {sieves: [0.0056, 0.008], fractions: [1.0]}
+  mass: 0.1
+process:
+  generation: {spacing: 0.009}
+  shaking: {duration: 0.2}
+experiment: {porosity: 0.4, std: 0.01}
+";
+
+#[test]
+fn pack_writes_consistent_outputs_that_the_porosity_command_confirms() {
+    let dir = tempfile::tempdir().unwrap();
+    let job = write(dir.path(), "small.yaml", SMALL_BED);
+    let out = dir.path().join("out");
+    let run = sedpack(&["pack", &job, "--out", out.to_str().unwrap(), "--json"]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let printed: Value = serde_json::from_slice(&run.stdout).unwrap();
+    let file: Value = serde_json::from_str(&std::fs::read_to_string(out.join("result.json")).unwrap()).unwrap();
+    assert_eq!(printed, file);
+    let n = file["porosity"].as_f64().unwrap();
+    assert!((0.3..0.5).contains(&n), "porosity {n}");
+    assert_eq!(file["experiment"]["porosity"], 0.4);
+    assert!(file["statistics"]["mean_FL"] == 1.0 && file["statistics"]["std_EL"] == 0.0, "spheres: FL = EL = 1");
+
+    // particles.csv → x,y,z,r → `sedpack porosity` with the pack's trim (the largest sieve,
+    // 8 mm) must give the same bulk porosity: the evaluation is one rule (§4.4) from two inputs.
+    let particles = std::fs::read_to_string(out.join("particles.csv")).unwrap();
+    let mut lines = particles.lines();
+    assert_eq!(lines.next().unwrap(), "id,shape,x,y,z,qw,qx,qy,qz,a,b,c,D,volume");
+    let mut xyzr = String::from("x,y,z,r\n");
+    let mut count = 0;
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        xyzr.push_str(&format!("{},{},{},{}\n", f[2], f[3], f[4], f[9]));
+        count += 1;
+    }
+    assert_eq!(count, file["particles"].as_u64().unwrap());
+    let csv = write(dir.path(), "xyzr.csv", &xyzr);
+    let check = sedpack(&["porosity", &csv, "--width", "0.04", "--slice", "0.001", "--trim", "0.008", "--json"]);
+    assert!(check.status.success(), "{}", String::from_utf8_lossy(&check.stderr));
+    let check: Value = serde_json::from_slice(&check.stdout).unwrap();
+    assert!((check["bulk_porosity"].as_f64().unwrap() - n).abs() < 1e-12);
+    assert_eq!(check["z_plus"], file["z_plus"]);
+
+    let profile = std::fs::read_to_string(out.join("profile.csv")).unwrap();
+    assert_eq!(profile.lines().next(), Some("z,n"));
+    assert_eq!(profile.lines().count() - 1, file["profile"].as_array().unwrap().len());
+    let vtk = std::fs::read(out.join("packing.vtk")).unwrap();
+    assert!(vtk.starts_with(b"# vtk DataFile Version 3.0\n"));
+}
+
+#[test]
+fn bad_job_files_name_the_file_line_and_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let unknown = write(dir.path(), "unknown.yaml", "domain:\n  kind: periodic\n  widht: 0.05\n");
+    fails(&["pack", &unknown], &["unknown.yaml:3", "domain", "widht"]);
+    let range = write(
+        dir.path(),
+        "range.yaml",
+        "grains:\n  shape: ellipsoid\n  form: {mu_fl: 0.6, sigma_fl: -0.2, mu_el: 0.7, sigma_el: 0.1}\n",
+    );
+    fails(&["pack", &range], &["range.yaml:3", "grains.form", "sigma_fl"]);
+    let mass = write(dir.path(), "mass.yaml", "grains:\n  mass: -2\n");
+    fails(&["pack", &mass], &["mass.yaml:2", "grains.mass", "-2"]);
+    let wrong = write(dir.path(), "wrong.yaml", "seed: many\n");
+    fails(&["pack", &wrong], &["wrong.yaml:1", "seed"]);
+    let step = write(dir.path(), "step.yaml", "solver: {time_step: 1.0e-4}\n");
+    fails(&["pack", &step], &["step.yaml:1", "solver.time_step", "collision_time / 10"]);
+    let case = write(dir.path(), "case.yaml", "grains: {size: U4}\n");
+    fails(&["pack", &case], &["case.yaml:1", "grains.size", "U4"]);
+    let grid = write(dir.path(), "grid.yaml", "grid:\n  seed: [1, 2]\n");
+    fails(&["pack", &grid], &["grid.yaml:1", "sedpack run"]);
+    let spheres = write(dir.path(), "spheres.yaml", "grains: {shape: sphere, form: {fl: 0.5, el: 0.5}}\n");
+    fails(&["pack", &spheres], &["grains.form", "spheres"]);
+    fails(&["pack", "/no/such/job.yaml"], &["/no/such/job.yaml"]);
+}
+
+#[test]
+fn porosity_command_evaluates_a_lattice_and_rejects_bad_rows() {
+    // Simple cubic lattice of 2 mm spheres, 5 × 5 per layer in a 10 mm box, 20 layers:
+    // the bulk porosity is 1 − π/6 (hand-checked in the solver's tests).
+    let dir = tempfile::tempdir().unwrap();
+    let mut csv = String::from("x,y,z,r\n");
+    for k in 0..20 {
+        for j in 0..5 {
+            for i in 0..5 {
+                csv.push_str(&format!(
+                    "{},{},{},0.001\n",
+                    0.001 + 0.002 * i as f64,
+                    0.001 + 0.002 * j as f64,
+                    0.001 + 0.002 * k as f64
+                ));
+            }
+        }
+    }
+    let path = write(dir.path(), "lattice.csv", &csv);
+    let out = sedpack(&["porosity", &path, "--width", "0.01", "--slice", "0.001", "--trim", "0.002", "--json"]);
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!((v["bulk_porosity"].as_f64().unwrap() - (1.0 - std::f64::consts::PI / 6.0)).abs() < 1e-9);
+    assert_eq!(v["particles"], 500);
+    let bad = write(dir.path(), "bad.csv", "x,y,z,r\n0,0,0.001,0.001\n0,0,abc,0.001\n");
+    fails(&["porosity", &bad, "--width", "0.01", "--trim", "0"], &["bad.csv", "line 3", "abc"]);
+    let missing = write(dir.path(), "missing.csv", "x,y,z\n0,0,0\n");
+    fails(&["porosity", &missing, "--width", "0.01", "--trim", "0"], &["missing.csv", "'r'"]);
+    fails(&["porosity", &path, "--width", "-1", "--trim", "0"], &["--width"]);
+}
