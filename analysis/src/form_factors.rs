@@ -1,16 +1,14 @@
-//! The 13 form factors of Table 1 and their inverses, computed per grain from (FL, EL), and the
-//! number-based statistics of a set of grains. The analysis keeps its own copy of the formulas
-//! because it reads store rows and measured grains, never solver types.
+//! Feature names built from the 13 form factors of Table 1, and per-grain features of measured
+//! (FL, EL) pairs. The formulas themselves live once, in `solver::grain`.
 
 use std::collections::BTreeMap;
 
-/// Table 1 abbreviations in the table's order.
-pub const FACTORS: [&str; 13] =
-    ["FL", "EL", "EQ", "ASF", "CSF", "DRI", "IFI", "IRI", "JFF", "KIS", "MPS", "OPI", "WFI"];
+use solver::grain::{FormFactor, FormParameters, feature_names, form_statistics};
 
-/// Relative tolerance under which two axes count as equal where a factor divides by their
-/// difference; the same value as the solver's, so both call the same forms undefined.
-pub const EQUAL_AXES_TOLERANCE: f64 = 1e-9;
+/// Table 1 abbreviations in the table's order.
+pub fn factors() -> [&'static str; 13] {
+    FormFactor::ALL.map(FormFactor::symbol)
+}
 
 /// Column name of the inverse of feature `name` ("EQ" → "inv_EQ").
 pub fn inverse_name(name: &str) -> String {
@@ -19,65 +17,36 @@ pub fn inverse_name(name: &str) -> String {
 
 /// The 26 per-grain features in Table 1 order, each followed by its inverse: FL, inv_FL, EL, …
 pub fn form_feature_names() -> Vec<String> {
-    FACTORS.iter().flat_map(|f| [f.to_string(), inverse_name(f)]).collect()
+    feature_names()
 }
 
-/// The 26 features of one form with axes L ≥ I ≥ S, in `form_feature_names` order; NaN where a
-/// factor is undefined (DRI, OPI for L = S; DRI⁻¹ for L = I; OPI⁻¹ for DRI = 1/2).
-pub fn form_features_of_axes(l: f64, i: f64, s: f64) -> [f64; 26] {
-    let sphere_like = l - s <= EQUAL_AXES_TOLERANCE * l;
-    let dri = if sphere_like { f64::NAN } else { (l - i) / (l - s) };
-    let opi = 10.0 * (dri - 0.5) / (s / l);
-    let values = [
-        s / i,
-        i / l,
-        s / l,
-        l * s / (i * i),
-        s / (l * i).sqrt(),
-        dri,
-        (l + s) / i,
-        (s + i) / l,
-        s / ((l * l + i * i + s * s) / 3.0).sqrt(),
-        (i * s / (l * l)).cbrt(),
-        (s * s / (l * i)).cbrt(),
-        opi,
-        (l + i) / (2.0 * s),
-    ];
-    let mut out = [0.0; 26];
-    for (k, v) in values.iter().enumerate() {
-        out[2 * k] = *v;
-        out[2 * k + 1] = 1.0 / v;
-    }
-    // DRI = 0 and OPI = 0 give ±∞ or a huge inverse from rounding; both are undefined.
-    if !sphere_like && l - i <= EQUAL_AXES_TOLERANCE * l {
-        out[2 * 5 + 1] = f64::NAN;
-    }
-    if (dri - 0.5).abs() <= EQUAL_AXES_TOLERANCE {
-        out[2 * 11 + 1] = f64::NAN;
+/// The form of a grain of flatness FL and elongation EL: the factors depend only on axis ratios.
+fn form(fl: f64, el: f64) -> FormParameters {
+    FormParameters::from_flatness_elongation(fl, el, 1.0)
+}
+
+/// The 26 features of a grain of flatness FL and elongation EL, in `form_feature_names` order;
+/// NaN where a factor is undefined (DRI, OPI for L = S; DRI⁻¹ for L = I; OPI⁻¹ for DRI = 1/2).
+pub fn form_features(fl: f64, el: f64) -> [f64; 26] {
+    let factors = form(fl, el).factors();
+    let mut out = [f64::NAN; 26];
+    for (k, (_, x, inv)) in factors.iter().enumerate() {
+        out[2 * k] = x.unwrap_or(f64::NAN);
+        out[2 * k + 1] = inv.unwrap_or(f64::NAN);
     }
     out
-}
-
-/// The 26 features of a grain of flatness FL and elongation EL: the factors depend only on axis
-/// ratios, so I = 1, L = 1/EL, S = FL.
-pub fn form_features(fl: f64, el: f64) -> [f64; 26] {
-    form_features_of_axes(1.0 / el, 1.0, fl)
 }
 
 /// Number-based mean and population standard deviation of the 26 features over a set of grains
 /// given as (FL, EL) pairs, keyed "FL", "inv_FL", …; NaN where any grain's value is undefined.
 pub fn grain_statistics(grains: &[(f64, f64)]) -> BTreeMap<String, (f64, f64)> {
-    let per_grain: Vec<[f64; 26]> = grains.iter().map(|&(fl, el)| form_features(fl, el)).collect();
-    let count = per_grain.len() as f64;
-    form_feature_names()
-        .into_iter()
-        .enumerate()
-        .map(|(k, name)| {
-            let mean = per_grain.iter().map(|g| g[k]).sum::<f64>() / count;
-            let variance = per_grain.iter().map(|g| (g[k] - mean).powi(2)).sum::<f64>() / count;
-            (name, (mean, variance.sqrt()))
-        })
-        .collect()
+    let forms: Vec<FormParameters> = grains.iter().map(|&(fl, el)| form(fl, el)).collect();
+    let mut stats: BTreeMap<String, (f64, f64)> =
+        form_feature_names().into_iter().map(|name| (name, (f64::NAN, f64::NAN))).collect();
+    for s in form_statistics(&forms) {
+        stats.insert(s.name, (s.mean, s.std));
+    }
+    stats
 }
 
 /// A reader's symbol for a feature column: "inv_mean_EQ" → "μ(EQ)⁻¹", "std_inv_EL" → "σ(EL⁻¹)".
@@ -140,8 +109,8 @@ mod tests {
         ];
         for (k, e) in expected.iter().enumerate() {
             // 1e-12: a handful of roundings on numbers of order 1.
-            assert!((f[2 * k] - e).abs() < 1e-12, "{}: {} vs {e}", FACTORS[k], f[2 * k]);
-            assert!((f[2 * k + 1] - 1.0 / e).abs() < 1e-12, "inv_{}", FACTORS[k]);
+            assert!((f[2 * k] - e).abs() < 1e-12, "{}: {} vs {e}", factors()[k], f[2 * k]);
+            assert!((f[2 * k + 1] - 1.0 / e).abs() < 1e-12, "inv_{}", factors()[k]);
         }
     }
 

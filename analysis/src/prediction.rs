@@ -11,6 +11,8 @@ use thiserror::Error;
 use crate::dataset::{
     DroppedFeature, is_single_form_statistics, mixture_feature_names, mixture_features, single_form_features,
 };
+use solver::grain::FormDistribution;
+
 use crate::form_factors::{form_feature_names, form_features, grain_statistics, inverse_name};
 use crate::model::{LinearModel, ModelError};
 
@@ -118,9 +120,9 @@ pub fn input_from_statistics(s: &FormStatistics) -> Result<ModelInput, Predictio
             )));
         }
     }
-    let mu_eq = s.mu_el * s.mu_fl;
-    let second = (s.mu_el.powi(2) + s.sigma_el.powi(2)) * (s.mu_fl.powi(2) + s.sigma_fl.powi(2));
-    let sigma_eq = (second - mu_eq * mu_eq).max(0.0).sqrt();
+    let (mu_eq, sigma_eq) =
+        FormDistribution { mu_fl: s.mu_fl, sigma_fl: s.sigma_fl, mu_el: s.mu_el, sigma_el: s.sigma_el }
+            .equancy_statistics();
     let mut features = BTreeMap::new();
     let mut unavailable = Vec::new();
     for (key, mean, std) in [("FL", s.mu_fl, s.sigma_fl), ("EL", s.mu_el, s.sigma_el), ("EQ", mu_eq, sigma_eq)] {

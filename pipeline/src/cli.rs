@@ -37,6 +37,28 @@ pub enum Command {
     Status(StatusArgs),
     /// One CSV row per job: parameters, porosity and grain statistics.
     Export(ExportArgs),
+    /// Fit and cross-validate porosity models on a campaign and write the report.
+    Report(ReportArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// The campaign's name.
+    pub name: String,
+    #[arg(long, default_value = DEFAULT_DB)]
+    pub db: PathBuf,
+    /// Output folder: report.html, report.md, dataset.csv, models/*.json, figures/*.svg.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Features correlated with the primary one above this |r| are removed (§6.3.3).
+    #[arg(long, default_value_t = 0.8)]
+    pub threshold: f64,
+    /// k of the k-fold cross-validation.
+    #[arg(long, default_value_t = 10)]
+    pub folds: usize,
+    /// Seed of the fold assignment.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
 }
 
 /// Default database file, in the current folder.
@@ -217,9 +239,10 @@ pub struct SampleSizesArgs {
 }
 
 #[derive(Debug, Args)]
-#[command(group(ArgGroup::new("form").required(true).args(["mu_fl", "fl"])))]
+#[command(group(ArgGroup::new("form").required(true).args(["mu_fl", "fl", "grains"])))]
 pub struct PredictArgs {
-    /// paper-U1 | paper-U7 (form mixtures, Eqs. 23–24) or paper-sf-U1 | paper-sf-U7 |
+    /// A saved model (MODEL.json, written by `sedpack report`), or one of the paper's:
+    /// paper-U1 | paper-U7 (form mixtures, Eqs. 23–24), paper-sf-U1 | paper-sf-U7 |
     /// paper-sf-B50 (single form, Eqs. 17–19).
     #[arg(long)]
     pub model: String,
@@ -237,6 +260,9 @@ pub struct PredictArgs {
     /// Elongation EL = I/L of a single form, in (0, 1].
     #[arg(long, allow_negative_numbers = true, requires = "fl")]
     pub el: Option<f64>,
+    /// A CSV of measured grains (a Zingg data set) with columns FL and EL.
+    #[arg(long)]
+    pub grains: Option<PathBuf>,
     #[arg(long)]
     pub json: bool,
 }

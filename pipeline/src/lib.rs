@@ -23,5 +23,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Resume(args) => commands::campaign::resume(&args),
         Command::Status(args) => commands::campaign::status(&args),
         Command::Export(args) => commands::campaign::export(&args),
+        Command::Report(args) => commands::report::run(&args),
     }
 }

@@ -35,12 +35,15 @@ pub fn write_packing(out: &mut impl Write, bodies: &Bodies, sizes: &[f64], title
         offset += vertices.len() as i32;
     }
     writeln!(out, "\nCELL_DATA {cells}")?;
-    let columns: [(&str, Box<dyn Fn(usize) -> f64>); 3] =
-        [("grain", Box::new(|k| k as f64)), ("D", Box::new(|k| sizes[k])), ("volume", Box::new(|k| bodies.volume[k]))];
-    for (name, value) in columns {
+    for name in ["grain", "D", "volume"] {
         writeln!(out, "SCALARS {name} float 1\nLOOKUP_TABLE default")?;
         for (k, (_, triangles)) in surfaces.iter().enumerate() {
-            let v = (value(k) as f32).to_be_bytes();
+            let value = match name {
+                "grain" => k as f64,
+                "D" => sizes[k],
+                _ => bodies.volume[k],
+            };
+            let v = (value as f32).to_be_bytes();
             for _ in triangles {
                 out.write_all(&v)?;
             }

@@ -43,10 +43,10 @@ fn settings() -> Settings {
 fn settled(bed: &Bed) -> Simulation {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/sedpack-bench");
     let path = dir.join(format!("{}.json", bed.name));
-    if let Ok(text) = std::fs::read_to_string(&path) {
-        if let Ok(sim) = serde_json::from_str(&text) {
-            return sim;
-        }
+    if let Ok(text) = std::fs::read_to_string(&path)
+        && let Ok(sim) = serde_json::from_str(&text)
+    {
+        return sim;
     }
     let mut rng = ChaCha8Rng::seed_from_u64(12345);
     let mut sim = Simulation::new(Domain::Periodic { width: bed.width }, settings()).unwrap();

@@ -13,7 +13,7 @@ use thiserror::Error;
 
 use crate::SolverError;
 use crate::dem::{Calibration, Domain, NewBody, Settings, Shaking, Shape, Simulation};
-use crate::grain::{FormDistribution, FormFactors, FormParameters, SieveCurve, SizeSampler};
+use crate::grain::{FormDistribution, FormParameters, FormStatistic, SieveCurve, SizeSampler, form_statistics};
 use crate::porosity::{self, Porosity, PorosityError, PorositySettings};
 
 /// Material constants of §4.2.
@@ -159,14 +159,6 @@ pub struct GrainRecord {
     pub form: FormParameters,
 }
 
-/// Number-based mean and standard deviation of a quantity over the grains.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Statistic {
-    pub name: &'static str,
-    pub mean: f64,
-    pub std: f64,
-}
-
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PackingResult {
     pub porosity: Porosity,
@@ -176,7 +168,7 @@ pub struct PackingResult {
     pub wall_time: Duration,
     /// Mean and (population) standard deviation of every Table 1 factor X and of X⁻¹ over the
     /// grains, where defined for every grain.
-    pub statistics: Vec<Statistic>,
+    pub statistics: Vec<FormStatistic>,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -270,13 +262,13 @@ impl Packing {
         let dt = self.spec.time_step;
         for _ in 0..max_steps {
             match self.phase {
-                Phase::Generation => {
-                    if self.simulation.steps % GENERATION_CHECK_STEPS == 0 && self.last_set_left() {
-                        self.generate_set();
-                        if self.created_mass >= self.spec.grains.mass {
-                            self.shaking_until = self.simulation.time + p.shaking_duration;
-                            self.phase = Phase::Shaking;
-                        }
+                Phase::Generation
+                    if self.simulation.steps.is_multiple_of(GENERATION_CHECK_STEPS) && self.last_set_left() =>
+                {
+                    self.generate_set();
+                    if self.created_mass >= self.spec.grains.mass {
+                        self.shaking_until = self.simulation.time + p.shaking_duration;
+                        self.phase = Phase::Shaking;
                     }
                 }
                 Phase::Shaking if self.simulation.time >= self.shaking_until => {
@@ -360,7 +352,7 @@ impl Packing {
         let b = &self.simulation.bodies;
         let r = body.shape.bounding_radius();
         (0..b.len()).any(|k| {
-            let shift = self.spec.domain.image_shift(&body.position, &b.position[k]);
+            let shift = self.spec.domain.shift(self.spec.domain.nearest_image(&body.position, &b.position[k]));
             let other = b.position[k] + shift;
             (other - body.position).norm() < r + b.bounding_radius[k]
         })
@@ -386,7 +378,7 @@ impl Packing {
             simulated_time: self.simulation.time,
             steps: self.simulation.steps,
             wall_time: self.wall_time,
-            statistics: grain_statistics(self.grains.iter().map(|g| g.form)),
+            statistics: form_statistics(&self.grains.iter().map(|g| g.form).collect::<Vec<_>>()),
         })
     }
 }
@@ -427,44 +419,4 @@ fn random_rotation(rng: &mut ChaCha8Rng) -> UnitQuaternion<f64> {
         a * (tau * u2).cos(),
         b * (tau * u3).sin(),
     ))
-}
-
-/// Number-based mean and population standard deviation of each Table 1 factor and its inverse,
-/// for those defined on every grain.
-pub fn grain_statistics(forms: impl Iterator<Item = FormParameters>) -> Vec<Statistic> {
-    const NAMES: [[&str; 2]; 13] = [
-        ["FL", "inv_FL"],
-        ["EL", "inv_EL"],
-        ["EQ", "inv_EQ"],
-        ["ASF", "inv_ASF"],
-        ["CSF", "inv_CSF"],
-        ["DRI", "inv_DRI"],
-        ["IFI", "inv_IFI"],
-        ["IRI", "inv_IRI"],
-        ["JFF", "inv_JFF"],
-        ["KIS", "inv_KIS"],
-        ["MPS", "inv_MPS"],
-        ["OPI", "inv_OPI"],
-        ["WFI", "inv_WFI"],
-    ];
-    let all: Vec<FormFactors> = forms.map(|f| f.factors()).collect();
-    let mut out = Vec::new();
-    for (k, names) in NAMES.iter().enumerate() {
-        for (inverse, name) in [(false, names[0]), (true, names[1])] {
-            let values: Option<Vec<f64>> = all
-                .iter()
-                .map(|f| {
-                    let (factor, x, inv) = f.iter().nth(k).expect("13 factors");
-                    debug_assert_eq!(factor.symbol(), names[0]);
-                    if inverse { inv.ok() } else { x.ok() }
-                })
-                .collect();
-            if let Some(v) = values.filter(|v| !v.is_empty()) {
-                let mean = v.iter().sum::<f64>() / v.len() as f64;
-                let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / v.len() as f64;
-                out.push(Statistic { name, mean, std: var.sqrt() });
-            }
-        }
-    }
-    out
 }

@@ -14,7 +14,7 @@ use thiserror::Error;
 
 use crate::correlation::correlation_matrix;
 use crate::dataset::{Dataset, DatasetError, FeatureKind};
-use crate::form_factors::{FACTORS, symbol};
+use crate::form_factors::{factors, symbol};
 use crate::model::LinearModel;
 use crate::plots::{self, PlotError, ScatterPlot, ZinggPacking};
 use crate::record::{CampaignSummary, JobRecord};
@@ -424,9 +424,9 @@ fn ranking_section(blocks: &mut Vec<Block>, d: &Dataset, s: &Selection) -> Resul
 
 fn correlation_section(blocks: &mut Vec<Block>, d: &Dataset) -> Result<(), ReportError> {
     let (names, what): (Vec<String>, &str) = match d.kind() {
-        FeatureKind::SingleForm => (FACTORS.iter().map(|f| f.to_string()).collect(), "the 13 form factors"),
+        FeatureKind::SingleForm => (factors().iter().map(|f| f.to_string()).collect(), "the 13 form factors"),
         FeatureKind::Mixture => {
-            (FACTORS.iter().map(|f| format!("mean_{f}")).collect(), "the packing means of the 13 form factors")
+            (factors().iter().map(|f| format!("mean_{f}")).collect(), "the packing means of the 13 form factors")
         }
     };
     let matrix = correlation_matrix(d, &names);

@@ -14,15 +14,12 @@ use crate::cli::{ExportArgs, ResumeArgs, RunArgs, StatusArgs};
 use crate::output::{Table, print_json};
 use crate::runner::{self, RunOptions, Summary};
 
-/// Table 1 factors in the order of the paper, for the export columns.
-const FACTORS: [&str; 13] = ["FL", "EL", "EQ", "ASF", "CSF", "DRI", "IFI", "IRI", "JFF", "KIS", "MPS", "OPI", "WFI"];
-
-fn runtime() -> anyhow::Result<tokio::runtime::Runtime> {
+pub(crate) fn runtime() -> anyhow::Result<tokio::runtime::Runtime> {
     Ok(tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?)
 }
 
 /// Opens an existing database; status, export and resume never create one.
-async fn open_existing(db: &Path) -> anyhow::Result<Store> {
+pub(crate) async fn open_existing(db: &Path) -> anyhow::Result<Store> {
     if !db.exists() {
         bail!("{}: no such database (start a campaign with `sedpack run CAMPAIGN.yaml`)", db.display());
     }
@@ -199,12 +196,7 @@ fn write_csv(out: &mut impl Write, rows: &[ExportRow]) -> anyhow::Result<()> {
             }
         }
     }
-    let mut statistics = Vec::new();
-    for x in FACTORS {
-        for name in [x.to_string(), format!("inv_{x}")] {
-            statistics.push(name);
-        }
-    }
+    let statistics = solver::grain::feature_names();
     let mut header = vec!["job_id".to_string(), "state".into(), "seed".into()];
     header.extend(keys.iter().cloned());
     header.extend(["porosity", "z_minus", "z_plus", "particles", "simulated_time", "wall_time"].map(String::from));

@@ -5,4 +5,5 @@ pub mod forms;
 pub mod pack;
 pub mod porosity;
 pub mod predict;
+pub mod report;
 pub mod sample;

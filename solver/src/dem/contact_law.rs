@@ -121,9 +121,9 @@ impl LinearSpringDashpot {
         let dt_damping = self.sqrt_kappa * dn;
         let mut tangential = -kt * displacement - dt_damping * ut;
         let limit = self.friction * normal_magnitude.abs();
-        let trial = tangential.norm();
-        if trial > limit {
-            tangential *= limit / trial;
+        let trial2 = tangential.norm_squared();
+        if trial2 > limit * limit {
+            tangential *= limit / trial2.sqrt();
             displacement = -(tangential + dt_damping * ut) / kt;
         }
         history.tangential_displacement = displacement;

@@ -48,15 +48,22 @@ impl Domain {
         }
     }
 
-    /// The periodic image offset s that makes x_j + s the image of j nearest to x_i.
+    /// The periodic image of j nearest to i, as whole periods to add to x_j in x and y.
     #[inline]
-    pub fn image_shift(&self, xi: &Vector3<f64>, xj: &Vector3<f64>) -> Vector3<f64> {
+    pub fn nearest_image(&self, xi: &Vector3<f64>, xj: &Vector3<f64>) -> [i16; 2] {
         match *self {
             Domain::Periodic { width } => {
-                Vector3::new(-width * ((xj.x - xi.x) / width).round(), -width * ((xj.y - xi.y) / width).round(), 0.0)
+                [(-((xj.x - xi.x) / width).round()) as i16, (-((xj.y - xi.y) / width).round()) as i16]
             }
-            Domain::Cylinder { .. } => Vector3::zeros(),
+            Domain::Cylinder { .. } => [0, 0],
         }
+    }
+
+    /// The offset of a periodic image.
+    #[inline]
+    pub fn shift(&self, image: [i16; 2]) -> Vector3<f64> {
+        let l = self.width();
+        Vector3::new(image[0] as f64 * l, image[1] as f64 * l, 0.0)
     }
 
     /// Whether a grain of bounding radius r centred at horizontal (x, y) lies inside the domain.

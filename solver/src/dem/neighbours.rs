@@ -10,13 +10,15 @@ use super::contact_law::ContactHistory;
 use super::domain::Domain;
 use crate::SolverError;
 
-/// Two bodies i < j whose bounding spheres, with j moved by `shift` (its periodic image nearest
-/// to i), are closer than the skin.
+/// Two bodies i < j whose bounding spheres, with j moved by whole periods `image` (its periodic
+/// image nearest to i), are closer than the skin.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Pair {
     pub i: u32,
     pub j: u32,
-    pub shift: Vector3<f64>,
+    pub image: [i16; 2],
+    /// m_i m_j / (m_i + m_j), the mass of Eq. 11, kept here to spare a division per step.
+    pub effective_mass: f64,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -189,10 +191,12 @@ impl NeighbourList {
                             if j <= i {
                                 continue;
                             }
-                            let shift = domain.image_shift(&xi, &bodies.position[j]);
+                            let image = domain.nearest_image(&xi, &bodies.position[j]);
                             let reach = bodies.bounding_radius[i] + bodies.bounding_radius[j] + self.skin;
-                            if (bodies.position[j] + shift - xi).norm_squared() < reach * reach {
-                                self.pairs.push(Pair { i: i as u32, j: j as u32, shift });
+                            if (bodies.position[j] + domain.shift(image) - xi).norm_squared() < reach * reach {
+                                let (mi, mj) = (bodies.mass[i], bodies.mass[j]);
+                                let effective_mass = mi * mj / (mi + mj);
+                                self.pairs.push(Pair { i: i as u32, j: j as u32, image, effective_mass });
                             }
                         }
                     }

@@ -1,9 +1,10 @@
 //! Grain shapes as rigid bodies: volume, principal moments of inertia and bounding sphere, all
 //! in the body frame, whose axes are the principal axes of inertia.
 
-use nalgebra::Vector3;
+use nalgebra::{UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
+use super::contact::ellipsoid::EllipsoidPose;
 use crate::grain::FormParameters;
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -77,6 +78,17 @@ impl Shape {
             *v = v.component_mul(&scale);
         }
         (vertices, triangles)
+    }
+
+    /// The precomputed ellipsoid of the narrow phase for a body at `position` turned by
+    /// `orientation`; None for spheres, whose contacts are analytic.
+    pub fn pose(&self, position: Vector3<f64>, orientation: &UnitQuaternion<f64>) -> Option<EllipsoidPose> {
+        match self {
+            Shape::Sphere { .. } => None,
+            Shape::Ellipsoid { semi_axes } => {
+                Some(EllipsoidPose::new(position, orientation.to_rotation_matrix().matrix(), *semi_axes))
+            }
+        }
     }
 
     /// Radius of the sphere of equal volume (used by the porosity evaluation, §4.4).

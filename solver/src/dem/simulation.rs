@@ -9,7 +9,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::body::{Bodies, NewBody};
-use super::contact::{self, ContactGeometry};
+use super::contact::ellipsoid::EllipsoidPose;
+use super::contact::{self, ContactGeometry, Placed};
 use super::contact_law::{Calibration, ContactHistory, LinearSpringDashpot};
 use super::domain::Domain;
 use super::neighbours::NeighbourList;
@@ -94,6 +95,9 @@ pub struct Simulation {
     pub contacts: usize,
     #[serde(skip)]
     pair_forces: Vec<PairForce>,
+    /// Narrow-phase ellipsoid of every non-spherical body at the current orientation.
+    #[serde(skip)]
+    poses: Vec<Option<EllipsoidPose>>,
     #[serde(skip)]
     pub stage_times: StageTimes,
 }
@@ -126,6 +130,7 @@ impl Simulation {
             damping: None,
             contacts: 0,
             pair_forces: Vec::new(),
+            poses: Vec::new(),
             stage_times: StageTimes::default(),
         })
     }
@@ -137,12 +142,23 @@ impl Simulation {
     pub fn add_body(&mut self, body: NewBody) -> usize {
         self.floor_history.push(ContactHistory::default());
         self.wall_history.push(ContactHistory::default());
+        self.refresh_poses();
+        self.poses.push(body.shape.pose(body.position, &body.orientation));
         self.bodies.push(body, self.settings.density)
+    }
+
+    /// Recomputes every pose when they are missing (a simulation restored from a checkpoint).
+    fn refresh_poses(&mut self) {
+        if self.poses.len() != self.bodies.len() {
+            let b = &self.bodies;
+            self.poses = (0..b.len()).map(|k| b.shape[k].pose(b.position[k], &b.orientation[k])).collect();
+        }
     }
 
     /// Advances the simulation by one time step Δt.
     pub fn step(&mut self) -> Result<(), SolverError> {
         let start = Instant::now();
+        self.refresh_poses();
         if self.neighbours.is_stale(&self.bodies) {
             self.neighbours.rebuild(&mut self.bodies, &self.domain)?;
         }
@@ -170,6 +186,8 @@ impl Simulation {
     /// and the largest overlap relative to the pair's smaller half-extent.
     fn pair_contacts(&mut self) -> (usize, f64) {
         let bodies = &self.bodies;
+        let domain = self.domain;
+        let poses = &self.poses;
         let law = &self.law;
         let dt = self.settings.time_step;
         self.pair_forces.resize(self.neighbours.pairs.len(), PairForce::default());
@@ -181,8 +199,11 @@ impl Simulation {
             .map(|((pair, history), out)| {
                 let (i, j) = (pair.i as usize, pair.j as usize);
                 let xi = bodies.position[i];
-                let xj = bodies.position[j] + pair.shift;
-                let Some(geometry) = contact::between(&bodies.shape[i], &xi, &bodies.shape[j], &xj) else {
+                let xj = bodies.position[j] + domain.shift(pair.image);
+                let a = Placed { shape: &bodies.shape[i], position: xi, pose: poses[i].as_ref() };
+                let b = Placed { shape: &bodies.shape[j], position: xj, pose: poses[j].as_ref() };
+                let warm = (history.normal != Vector3::zeros()).then_some(&history.normal);
+                let Some(geometry) = contact::between(&a, &b, warm) else {
                     *history = ContactHistory::default();
                     *out = PairForce::default();
                     return (0, 0.0);
@@ -190,8 +211,7 @@ impl Simulation {
                 let arm_i = geometry.point - xi;
                 let arm_j = geometry.point - xj;
                 let relative = bodies.point_velocity(j, &arm_j) - bodies.point_velocity(i, &arm_i);
-                let (mi, mj) = (bodies.mass[i], bodies.mass[j]);
-                let force = law.force(mi * mj / (mi + mj), &geometry, &relative, history, dt);
+                let force = law.force(pair.effective_mass, &geometry, &relative, history, dt);
                 *out = PairForce { force, torque_i: force.cross(&arm_i), torque_j: arm_j.cross(&force) };
                 let scale = bodies.shape[i].smallest_half_extent().min(bodies.shape[j].smallest_half_extent());
                 (1, geometry.depth / scale)
@@ -220,10 +240,11 @@ impl Simulation {
             b.angular_velocity.par_iter_mut(),
             self.floor_history.par_iter_mut(),
             self.wall_history.par_iter_mut(),
+            self.poses.par_iter_mut(),
         )
             .into_par_iter()
             .enumerate()
-            .map(|(k, (x, q, v, w, floor, wall))| {
+            .map(|(k, (x, q, v, w, floor, wall, pose))| {
                 let shape = &b.shape[k];
                 let mass = b.mass[k];
                 let mut force = weight_per_volume * b.volume[k] + Vector3::new(mass * shaking, 0.0, 0.0);
@@ -239,8 +260,9 @@ impl Simulation {
                     }
                 }
                 let mut wall_contacts = 0;
+                let placed = Placed { shape, position: *x, pose: pose.as_ref() };
                 let walls =
-                    [(contact::with_floor(shape, x), &mut *floor), (contact::with_wall(shape, x, &domain), &mut *wall)];
+                    [(contact::with_floor(&placed), &mut *floor), (contact::with_wall(&placed, &domain), &mut *wall)];
                 for (geometry, history) in walls {
                     match geometry {
                         Some(g) => {
@@ -276,6 +298,9 @@ impl Simulation {
                     *v *= c;
                     *w *= c;
                 }
+                if pose.is_some() {
+                    *pose = shape.pose(*x, q);
+                }
                 // The sum is finite exactly when every component is (NaN and ±∞ propagate).
                 (wall_contacts, (x.sum() + v.sum() + w.sum()).is_finite())
             })
@@ -292,7 +317,11 @@ impl Simulation {
     /// The exact contact of two bodies as the narrow phase sees it, for inspection and tests.
     pub fn body_contact(&self, i: usize, j: usize) -> Option<ContactGeometry> {
         let b = &self.bodies;
-        let shift = self.domain.image_shift(&b.position[i], &b.position[j]);
-        contact::between(&b.shape[i], &b.position[i], &b.shape[j], &(b.position[j] + shift))
+        let shift = self.domain.shift(self.domain.nearest_image(&b.position[i], &b.position[j]));
+        let pose = |k: usize| b.shape[k].pose(b.position[k], &b.orientation[k]);
+        let (pi, pj) = (pose(i), pose(j));
+        let a = Placed { shape: &b.shape[i], position: b.position[i], pose: pi.as_ref() };
+        let c = Placed { shape: &b.shape[j], position: b.position[j] + shift, pose: pj.as_ref() };
+        contact::between(&a, &c, None)
     }
 }

@@ -230,3 +230,41 @@ impl FormFactors {
         FormFactor::ALL.iter().map(|&f| (f, self.get(f), self.inverse(f)))
     }
 }
+
+/// Names of the 26 per-grain features in Table 1 order, each factor followed by its inverse:
+/// "FL", "inv_FL", "EL", "inv_EL", … (§6.3.1).
+pub fn feature_names() -> Vec<String> {
+    FormFactor::ALL.iter().flat_map(|f| [f.symbol().to_string(), format!("inv_{}", f.symbol())]).collect()
+}
+
+/// Number-based mean and population standard deviation of one feature over a population.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FormStatistic {
+    /// "FL", "inv_FL", … as in [`feature_names`].
+    pub name: String,
+    pub mean: f64,
+    pub std: f64,
+}
+
+/// Statistics of the 26 features over the given forms, in [`feature_names`] order; a feature
+/// undefined for any grain (e.g. DRI of a sphere) is left out.
+pub fn form_statistics(forms: &[FormParameters]) -> Vec<FormStatistic> {
+    let factors: Vec<FormFactors> = forms.iter().map(FormParameters::factors).collect();
+    let mut out = Vec::new();
+    for factor in FormFactor::ALL {
+        for inverse in [false, true] {
+            let values: Result<Vec<f64>, Undefined> =
+                factors.iter().map(|f| if inverse { f.inverse(factor) } else { f.get(factor) }).collect();
+            let Ok(values) = values else { continue };
+            if values.is_empty() {
+                continue;
+            }
+            let n = values.len() as f64;
+            let mean = values.iter().sum::<f64>() / n;
+            let variance = values.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n;
+            let prefix = if inverse { "inv_" } else { "" };
+            out.push(FormStatistic { name: format!("{prefix}{}", factor.symbol()), mean, std: variance.sqrt() });
+        }
+    }
+    out
+}

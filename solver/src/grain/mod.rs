@@ -11,7 +11,10 @@ pub mod size;
 pub mod unit_mesh;
 
 pub use ellipsoid::EquivalentEllipsoid;
-pub use form::{FactorValue, FormError, FormFactor, FormFactors, FormParameters, Undefined};
+pub use form::{
+    FactorValue, FormError, FormFactor, FormFactors, FormParameters, FormStatistic, Undefined, feature_names,
+    form_statistics,
+};
 pub use form_distribution::{DistributionError, FormDistribution, FormMoments, FormSampler};
 pub use mesh::{MassProperties, MeshDefect, MeshError, TriMesh};
 pub use size::{SieveCurve, SizeError, SizeSampler, TABLE3, TABLE3_SIEVES, Table3Case};

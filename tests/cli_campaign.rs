@@ -1,0 +1,244 @@
+//! End-to-end tests of campaigns: `sedpack run`, `resume`, `status`, `export` and `report` on
+//! small real packings, including kill -9 in the middle of a job.
+
+use std::path::Path;
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+use serde_json::Value;
+use store::{ExportRow, JobState, Store};
+
+fn sedpack(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sedpack")).args(args).output().expect("sedpack runs")
+}
+
+fn ok(args: &[&str]) -> String {
+    let out = sedpack(args);
+    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8(out.stdout).unwrap()
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+/// A 2 × 2 grid of sphere packings of ~60 grains; `shaking` sets how long each runs.
+fn campaign(name: &str, shaking: f64) -> String {
+    format!(
+        "name: {name}
+domain: {{kind: periodic, width: 0.03, height: 0.1}}
+grains:
+  shape: sphere
+  size: {{sieves: [0.0056, 0.008], fractions: [1.0]}}
+  mass: 0.03
+process:
+  generation: {{spacing: 0.009}}
+  shaking: {{duration: {shaking}}}
+evaluation: {{trim: 0.004}}
+grid:
+  material.friction: [0.0, 0.5]
+seeds: [1, 2]
+"
+    )
+}
+
+fn rows(db: &str, name: &str) -> Vec<ExportRow> {
+    let rt = tokio::runtime::Runtime::new().unwrap();
+    rt.block_on(async { Store::open(db).await.unwrap().export(name).await.unwrap() })
+}
+
+/// job id → porosity bits of the finished jobs.
+fn porosities(db: &str, name: &str) -> Vec<(String, u64)> {
+    let mut out: Vec<(String, u64)> =
+        rows(db, name).iter().filter_map(|r| Some((r.job_id.clone(), r.result.as_ref()?.porosity.to_bits()))).collect();
+    out.sort();
+    out
+}
+
+#[test]
+fn a_grid_campaign_runs_once_and_reports() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "grid.yaml", &campaign("grid", 0.05));
+    let db = dir.path().join("sedpack.db");
+    let db = db.to_str().unwrap();
+    let first = ok(&["run", &file, "--db", db, "--workers", "2", "--quiet"]);
+    assert!(first.contains("4 job(s), 4 new"), "{first}");
+    let status: Value = serde_json::from_str(&ok(&["status", "grid", "--db", db, "--json"])).unwrap();
+    assert_eq!(
+        (status["jobs"].as_u64(), status["done"].as_u64(), status["pending"].as_u64()),
+        (Some(4), Some(4), Some(0))
+    );
+    let before = porosities(db, "grid");
+
+    // Submitting the same campaign again adds no job and runs nothing.
+    let again = ok(&["run", &file, "--db", db, "--quiet"]);
+    assert!(again.contains("4 job(s), 0 new") && again.contains("0 job(s) finished now"), "{again}");
+    assert_eq!(porosities(db, "grid"), before);
+    // Adding a grid value adds only the new jobs.
+    let wider = write(dir.path(), "grid.yaml", &campaign("grid", 0.05).replace("[0.0, 0.5]", "[0.0, 0.5, 0.3]"));
+    let third = ok(&["run", &wider, "--db", db, "--quiet"]);
+    assert!(third.contains("6 job(s), 2 new") && third.contains("2 job(s) finished now"), "{third}");
+
+    let csv = ok(&["export", "grid", "--db", db, "--format", "csv"]);
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(&header[..4], ["job_id", "state", "seed", "material.friction"]);
+    assert!(header.contains(&"porosity") && header.contains(&"mean_inv_EQ") && header.contains(&"std_WFI"));
+    let porosity_at = header.iter().position(|h| *h == "porosity").unwrap();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 6);
+    for row in &rows {
+        let n: f64 = row[porosity_at].parse().unwrap();
+        assert!((0.25..0.6).contains(&n) && row[1] == "done");
+    }
+
+    let out = dir.path().join("report");
+    ok(&["report", "grid", "--db", db, "--out", out.to_str().unwrap()]);
+    let dataset = std::fs::read_to_string(out.join("dataset.csv")).unwrap();
+    assert_eq!(dataset.lines().count(), 7, "header and one row per finished job");
+    assert!(std::fs::read_to_string(out.join("report.html")).unwrap().contains("<svg"));
+}
+
+#[test]
+fn a_killed_runner_resumes_from_its_checkpoint_with_identical_results() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = campaign("killed", 0.6);
+    let file = write(dir.path(), "killed.yaml", &text);
+    let reference_db = dir.path().join("reference.db");
+    let reference_db = reference_db.to_str().unwrap();
+    ok(&["run", &file, "--db", reference_db, "--workers", "2", "--quiet"]);
+    let reference = porosities(reference_db, "killed");
+    assert_eq!(reference.len(), 4);
+
+    // One worker, a checkpoint every 0.2 s; killed once a job has finished and another has a
+    // checkpoint.
+    let db = dir.path().join("killed.db");
+    let db = db.to_str().unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sedpack"))
+        .args(["run", &file, "--db", db, "--workers", "1", "--quiet", "--checkpoint-interval", "0.2"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let rt = tokio::runtime::Runtime::new().unwrap();
+    let start = Instant::now();
+    loop {
+        assert!(start.elapsed() < Duration::from_secs(120), "no checkpoint appeared");
+        std::thread::sleep(Duration::from_millis(100));
+        if !Path::new(db).exists() {
+            continue;
+        }
+        let ready = rt.block_on(async {
+            let Ok(store) = Store::open(db).await else { return false };
+            let Ok(running) = store.running_jobs("killed").await else { return false };
+            let Ok(status) = store.status("killed").await else { return false };
+            let mut checkpointed = false;
+            for job in &running {
+                checkpointed |= store.load_checkpoint(&job.job_id).await.ok().flatten().is_some();
+            }
+            status.done >= 1 && checkpointed
+        });
+        if ready {
+            break;
+        }
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let running = rows(db, "killed").iter().filter(|r| r.state == JobState::Running).count();
+    assert_eq!(running, 1, "the killed runner left its job running");
+
+    let resumed = ok(&["resume", "killed", "--db", db, "--quiet"]);
+    assert!(resumed.contains("4 done"), "{resumed}");
+    assert_eq!(porosities(db, "killed"), reference, "identical results, bit for bit");
+    for row in rows(db, "killed") {
+        assert_eq!(row.state, JobState::Done);
+        assert!(row.attempts <= 2, "each job runs once, the killed one twice");
+    }
+    let log = std::fs::read_to_string(dir.path().join("killed.log")).unwrap();
+    assert!(log.contains("requeued the job of a dead worker") && log.contains("resuming from a checkpoint"), "{log}");
+}
+
+#[test]
+fn two_runners_share_the_work_without_duplicates() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "shared.yaml", &campaign("shared", 0.05).replace("seeds: [1, 2]", "seeds: [1, 2, 3]"));
+    let db = dir.path().join("shared.db");
+    let db = db.to_str().unwrap();
+    let spawn = || {
+        Command::new(env!("CARGO_BIN_EXE_sedpack"))
+            .args(["run", &file, "--db", db, "--workers", "1", "--quiet"])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let (a, b) = (spawn(), spawn());
+    let (a, b) = (a.wait_with_output().unwrap(), b.wait_with_output().unwrap());
+    assert!(
+        a.status.success() && b.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&a.stderr),
+        String::from_utf8_lossy(&b.stderr)
+    );
+    let rows = rows(db, "shared");
+    assert_eq!(rows.len(), 6);
+    assert!(rows.iter().all(|r| r.state == JobState::Done && r.attempts == 1), "every job claimed exactly once");
+    let finished = |o: &Output| {
+        let text = String::from_utf8_lossy(&o.stdout).to_string();
+        let line = text.lines().find(|l| l.contains("finished now")).unwrap().to_string();
+        line.split_whitespace().nth(1).unwrap().parse::<usize>().unwrap()
+    };
+    assert_eq!(finished(&a) + finished(&b), 6, "the two runners split the six jobs");
+}
+
+#[test]
+fn failing_jobs_are_recorded_and_retried_on_request() {
+    // A 12 mm periodic square is too narrow for 8 mm grains (minimum image), so that job fails
+    // with the solver's error while the other runs.
+    let dir = tempfile::tempdir().unwrap();
+    let text = campaign("failing", 0.05)
+        .replace("  material.friction: [0.0, 0.5]\nseeds: [1, 2]", "  domain.width: [0.03, 0.012]");
+    let file = write(dir.path(), "failing.yaml", &text);
+    let db = dir.path().join("f.db");
+    let db = db.to_str().unwrap();
+    let out = ok(&["run", &file, "--db", db, "--quiet"]);
+    assert!(out.contains("1 job(s) finished now, 1 failed now"), "{out}");
+    assert!(out.contains("must be wider"), "the failure is shown with its error: {out}");
+    let status: Value = serde_json::from_str(&ok(&["status", "failing", "--db", db, "--json"])).unwrap();
+    assert_eq!(status["failed"], 1);
+    assert!(status["failures"][0]["error"].as_str().unwrap().contains("periodic domain"));
+    let retried = ok(&["run", &file, "--db", db, "--retry-failed", "--quiet"]);
+    assert!(retried.contains("1 failed job(s) returned to pending") && retried.contains("1 failed now"), "{retried}");
+}
+
+#[test]
+fn bad_campaigns_and_databases_are_refused_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    let fails = |args: &[&str], needles: &[&str]| {
+        let out = sedpack(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+        for n in needles {
+            assert!(stderr.contains(n), "'{stderr}' lacks '{n}'");
+        }
+    };
+    let db = dir.path().join("x.db");
+    let db = db.to_str().unwrap();
+    let empty = write(dir.path(), "empty.yaml", "name: e\ngrid:\n  material.friction: []\n");
+    fails(&["run", &empty, "--db", db], &["empty.yaml:3", "grid.material.friction", "empty list"]);
+    let typo = write(dir.path(), "typo.yaml", "name: t\ngrains:\n  shape: sphere\n  mas: 0.1\n");
+    fails(&["run", &typo, "--db", db], &["typo.yaml:4", "grains.mas"]);
+    let grid_range = write(dir.path(), "range.yaml", "name: r\ngrid:\n  material.friction: [0.5, -1.0]\n");
+    fails(&["run", &grid_range, "--db", db], &["material.friction", "-1", "grid point"]);
+
+    // A corrupt file and a foreign SQLite database are refused and left exactly as they were.
+    let ok_campaign = write(dir.path(), "ok.yaml", &campaign("ok", 0.05));
+    let corrupt = dir.path().join("corrupt.db");
+    std::fs::write(&corrupt, b"this is not a database at all, just some bytes").unwrap();
+    let before = std::fs::read(&corrupt).unwrap();
+    fails(&["run", &ok_campaign, "--db", corrupt.to_str().unwrap()], &["corrupt.db"]);
+    assert_eq!(std::fs::read(&corrupt).unwrap(), before);
+    fails(&["status", "--db", dir.path().join("missing.db").to_str().unwrap()], &["missing.db", "no such database"]);
+}
