@@ -11,7 +11,9 @@ use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_m
 use nalgebra::{UnitQuaternion, Vector3};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use solver::dem::{Calibration, Domain, NewBody, Settings, Shape, Simulation};
+use solver::dem::{Calibration, Domain, NewBody, Settings, Shaking, Shape, Simulation};
+use solver::grain::{FormDistribution, SieveCurve};
+use solver::packing::{FormSpec, GrainSpec, Material, Packing, PackingSpec, Phase, Process, ShapeKind};
 
 struct Bed {
     name: &'static str,
@@ -40,12 +42,70 @@ fn settings() -> Settings {
     }
 }
 
+fn cache(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../target/sedpack-bench/{name}.json"))
+}
+
+fn cached(name: &str) -> Option<Simulation> {
+    serde_json::from_str(&std::fs::read_to_string(cache(name)).ok()?).ok()
+}
+
+fn store(name: &str, sim: &Simulation) {
+    let path = cache(name);
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    std::fs::write(&path, serde_json::to_string(sim).unwrap()).unwrap();
+}
+
+/// A bed of ellipsoids of the Rhine form distribution (Table 2) in the 5.6–8 mm class, made by
+/// the packing protocol itself (§4.3) with a short shaking, in a periodic square of `width`.
+fn ellipsoid_bed(name: &str, width: f64, mass: f64) -> Simulation {
+    if let Some(sim) = cached(name) {
+        return sim;
+    }
+    let spec = PackingSpec {
+        domain: Domain::Periodic { width },
+        height: 0.4,
+        grains: GrainSpec {
+            shape: ShapeKind::Ellipsoid,
+            size: SieveCurve::new(vec![5.6e-3, 8e-3], vec![1.0]).unwrap(),
+            mass,
+            form: FormSpec::Distribution(FormDistribution {
+                mu_fl: 0.647,
+                sigma_fl: 0.175,
+                mu_el: 0.682,
+                sigma_el: 0.139,
+            }),
+        },
+        material: Material::default(),
+        time_step: 5e-6,
+        calibration: Calibration::Discrete { time_step: 5e-6 },
+        process: Process {
+            spacing: 0.012,
+            velocity: 1.0,
+            shaking: Shaking { amplitude: 3e-4, period: 0.025 },
+            shaking_duration: 0.2,
+            damping: 1e-3,
+            height_change: 1e-5,
+            interval: 0.01,
+            max_time: 30.0,
+        },
+        slice: 1e-3,
+        cutoff: 0.5,
+        trim: None,
+        seed: 1,
+    };
+    eprintln!("packing {name} for the benchmark, cached in {}", cache(name).display());
+    let mut packing = Packing::new(spec).unwrap();
+    while packing.advance(10_000).unwrap() != Phase::Converged {}
+    let mut sim = packing.simulation;
+    sim.damping = None;
+    sim.shaking = None;
+    store(name, &sim);
+    sim
+}
+
 fn settled(bed: &Bed) -> Simulation {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/sedpack-bench");
-    let path = dir.join(format!("{}.json", bed.name));
-    if let Ok(text) = std::fs::read_to_string(&path)
-        && let Ok(sim) = serde_json::from_str(&text)
-    {
+    if let Some(sim) = cached(bed.name) {
         return sim;
     }
     let mut rng = ChaCha8Rng::seed_from_u64(12345);
@@ -67,7 +127,7 @@ fn settled(bed: &Bed) -> Simulation {
             }
         }
     }
-    eprintln!("settling {} ({} grains), cached in {}", bed.name, sim.bodies.len(), path.display());
+    eprintln!("settling {} ({} grains), cached in {}", bed.name, sim.bodies.len(), cache(bed.name).display());
     while sim.time < 0.5 {
         sim.step().unwrap();
     }
@@ -77,8 +137,7 @@ fn settled(bed: &Bed) -> Simulation {
         sim.step().unwrap();
     }
     sim.damping = None;
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(&path, serde_json::to_string(&sim).unwrap()).unwrap();
+    store(bed.name, &sim);
     sim
 }
 
@@ -89,13 +148,18 @@ fn particle_steps(c: &mut Criterion) {
     ];
     let mut group = c.benchmark_group("settled_bed");
     group.sample_size(10);
-    for bed in &beds {
-        let base = settled(bed);
+    // About 2,000 and 8,000 ellipsoids (mean grain mass 0.66 g).
+    let ellipsoids = [("ellipsoids-2000", 0.06, 1.32), ("ellipsoids-8000", 0.12, 5.3)];
+    let all = beds
+        .iter()
+        .map(|bed| (bed.name, settled(bed)))
+        .chain(ellipsoids.iter().map(|&(n, w, m)| (n, ellipsoid_bed(n, w, m))));
+    for (name, base) in all {
         group.throughput(Throughput::Elements(base.bodies.len() as u64));
         for threads in [1, 2] {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             let mut sim = base.clone();
-            group.bench_function(BenchmarkId::new(bed.name, format!("{threads} threads")), |b| {
+            group.bench_function(BenchmarkId::new(name, format!("{threads} threads")), |b| {
                 pool.install(|| b.iter(|| sim.step().unwrap()))
             });
         }

@@ -94,7 +94,7 @@ impl LinearSpringDashpot {
     /// tangent plane keeping its length, advanced by u_t Δt, and the trial force
     /// −k_t δ_t − d_t u_t is capped at μ|F_n|; when it slips, δ_t is reset to the value whose
     /// spring and dashpot give exactly the capped force.
-    #[inline]
+    #[inline(always)]
     pub fn force(
         &self,
         effective_mass: f64,

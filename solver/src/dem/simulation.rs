@@ -259,23 +259,22 @@ impl Simulation {
                         torque += pf.torque_j;
                     }
                 }
-                let mut wall_contacts = 0;
                 let placed = Placed { shape, position: *x, pose: pose.as_ref() };
-                let walls =
-                    [(contact::with_floor(&placed), &mut *floor), (contact::with_wall(&placed, &domain), &mut *wall)];
-                for (geometry, history) in walls {
-                    match geometry {
-                        Some(g) => {
-                            // The wall is body B, immovable: m_eff = m and its velocity is zero.
-                            let arm = g.point - *x;
-                            let relative = -(*v + w.cross(&arm));
-                            let f = -law.force(mass, &g, &relative, history, dt);
-                            force += f;
-                            torque += arm.cross(&f);
-                            wall_contacts += 1;
-                        }
-                        None => *history = ContactHistory::default(),
-                    }
+                let mut wall_contacts = 0;
+                for (geometry, history) in
+                    [(contact::with_floor(&placed), &mut *floor), (contact::with_wall(&placed, &domain), &mut *wall)]
+                {
+                    let Some(g) = geometry else {
+                        *history = ContactHistory::default();
+                        continue;
+                    };
+                    // The wall is body B, immovable: m_eff = m and its velocity is zero.
+                    let arm = g.point - *x;
+                    let relative = -(*v + w.cross(&arm));
+                    let f = -law.force(mass, &g, &relative, history, dt);
+                    force += f;
+                    torque += arm.cross(&f);
+                    wall_contacts += 1;
                 }
 
                 *v += force * (dt / mass);
@@ -291,9 +290,11 @@ impl Simulation {
                     *w += q.transform_vector(&body_wdot) * dt;
                 }
                 *x += *v * dt;
-                // q ← q + ½ Δt (0, ω) q, renormalised: exact to O((|ω|Δt)³) per step.
-                let dq = Quaternion::from_imag(*w * (0.5 * dt)) * q.quaternion();
-                *q = UnitQuaternion::new_normalize(q.quaternion() + dq);
+                // q ← q + ½ Δt (0, ω) q, exact to O((|ω|Δt)³) per step, then renormalised by one
+                // Newton step for 1/|q| about 1: |q|² − 1 is O((|ω|Δt)²), so the error is of
+                // its square, below round-off, and no square root or division is needed.
+                let p = q.quaternion() + Quaternion::from_imag(*w * (0.5 * dt)) * q.quaternion();
+                *q = UnitQuaternion::new_unchecked(p * (0.5 * (3.0 - p.norm_squared())));
                 if let Some(c) = damping {
                     *v *= c;
                     *w *= c;

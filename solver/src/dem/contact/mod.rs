@@ -44,14 +44,20 @@ impl Placed<'_> {
 }
 
 /// Contact of body A with body B; `warm` is the pair's normal at the previous step, if any.
-#[inline]
+#[inline(always)]
 pub fn between(a: &Placed, b: &Placed, warm: Option<&Vector3<f64>>) -> Option<ContactGeometry> {
     match (a.shape, b.shape) {
         (Shape::Sphere { radius: ra }, Shape::Sphere { radius: rb }) => {
             sphere::sphere_sphere(&a.position, *ra, &b.position, *rb)
         }
-        _ => ellipsoid::ellipsoid_ellipsoid(&a.ellipsoid(), &b.ellipsoid(), warm),
+        _ => curved(a, b, warm),
     }
+}
+
+/// The non-spherical pairs, kept out of line so that the sphere path stays small.
+#[inline(never)]
+fn curved(a: &Placed, b: &Placed, warm: Option<&Vector3<f64>>) -> Option<ContactGeometry> {
+    ellipsoid::ellipsoid_ellipsoid(&a.ellipsoid(), &b.ellipsoid(), warm)
 }
 
 /// Contact of a body with the floor z = 0.
