@@ -195,20 +195,20 @@ fn two_runners_share_the_work_without_duplicates() {
 
 #[test]
 fn failing_jobs_are_recorded_and_retried_on_request() {
-    // A 12 mm periodic square is too narrow for 8 mm grains (minimum image), so that job fails
-    // with the solver's error while the other runs.
+    // A packing allowed 0.02 s of simulated time cannot settle, so that job fails with the
+    // solver's error while the other runs.
     let dir = tempfile::tempdir().unwrap();
     let text = campaign("failing", 0.05)
-        .replace("  material.friction: [0.0, 0.5]\nseeds: [1, 2]", "  domain.width: [0.03, 0.012]");
+        .replace("  material.friction: [0.0, 0.5]\nseeds: [1, 2]", "  solver.max_time: [30, 0.02]");
     let file = write(dir.path(), "failing.yaml", &text);
     let db = dir.path().join("f.db");
     let db = db.to_str().unwrap();
     let out = ok(&["run", &file, "--db", db, "--quiet"]);
     assert!(out.contains("1 job(s) finished now, 1 failed now"), "{out}");
-    assert!(out.contains("must be wider"), "the failure is shown with its error: {out}");
+    assert!(out.contains("not converged"), "the failure is shown with its error: {out}");
     let status: Value = serde_json::from_str(&ok(&["status", "failing", "--db", db, "--json"])).unwrap();
     assert_eq!(status["failed"], 1);
-    assert!(status["failures"][0]["error"].as_str().unwrap().contains("periodic domain"));
+    assert!(status["failures"][0]["error"].as_str().unwrap().contains("solver.max_time = 0.02"));
     let retried = ok(&["run", &file, "--db", db, "--retry-failed", "--quiet"]);
     assert!(retried.contains("1 failed job(s) returned to pending") && retried.contains("1 failed now"), "{retried}");
 }

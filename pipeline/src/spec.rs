@@ -101,7 +101,7 @@ pub enum CalibrationFile {
 pub struct SolverFile {
     pub time_step: Option<f64>,
     pub calibration: Option<CalibrationFile>,
-    pub max_time: Option<f64>,
+    pub max_time: Option<Auto>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -403,7 +403,10 @@ pub fn resolve(file: JobFile, source: &Source) -> anyhow::Result<JobSpec> {
         Auto::Auto => ((bed + 2.0 * spacing) / 0.6 * 100.0).ceil() / 100.0,
     };
     // Generation plus settling rarely takes more than a minute of simulated time.
-    let max_time = positive(source, "solver.max_time", s.max_time.unwrap_or(duration + 60.0))?;
+    let max_time = match s.max_time.unwrap_or(Auto::Auto) {
+        Auto::Auto => duration + 60.0,
+        Auto::Value(t) => positive(source, "solver.max_time", t)?,
+    };
 
     let slice = positive(source, "evaluation.slice", e.slice.unwrap_or(1e-3))?;
     let cutoff = e.cutoff.unwrap_or(0.5);

@@ -20,7 +20,7 @@ pub enum SolverError {
     )]
     TimeStepTooLarge { time_step: f64, collision_time: f64 },
     #[error(
-        "the periodic domain (width {width} m) must be wider than twice the reach of the largest grain pair ({reach} m)"
+        "the periodic domain (width {width} m) must be wider than its longest grain reaches ({reach} m: twice the largest half-length plus the skin); widen domain.width or narrow the form distribution"
     )]
     DomainTooNarrow { width: f64, reach: f64 },
     #[error(

@@ -113,7 +113,7 @@ pub enum PackingError {
     Porosity(#[from] PorosityError),
     #[error("process.spacing = {spacing} m leaves no grid position in the generation region of the domain")]
     NoGridPositions { spacing: f64 },
-    #[error("not converged after process.max_time = {0} s of simulated time")]
+    #[error("not converged after solver.max_time = {0} s of simulated time")]
     NotConverged(f64),
     #[error("the packing has not converged yet")]
     Unfinished,

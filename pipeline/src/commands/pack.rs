@@ -40,22 +40,9 @@ pub fn run(args: &PackArgs) -> anyhow::Result<()> {
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from(&job.name));
     let mut packing = Packing::new(job.packing.clone()).with_context(|| format!("{}", args.job.display()))?;
     let bar = progress_bar(args.json);
-    loop {
-        let phase = packing.advance(STEPS_PER_UPDATE).with_context(|| format!("{}", args.job.display()))?;
-        let p = packing.progress();
-        bar.set_message(format!(
-            "{:<10} t = {:7.3} s  grains {:6} ({:3.0} % of the mass)  contacts {:7}",
-            p.phase.name(),
-            p.time,
-            p.grains,
-            100.0 * p.created,
-            p.contacts
-        ));
-        bar.tick();
-        if phase == Phase::Converged {
-            break;
-        }
-    }
+    // Stepping from inside the pool spares every parallel loop a hand-over to the pool.
+    let pool = rayon::ThreadPoolBuilder::new().build()?;
+    pool.install(|| run_to_convergence(&mut packing, &bar, &args.job))?;
     bar.finish_and_clear();
     let result = packing.result().with_context(|| format!("{}", args.job.display()))?;
     write_outputs(&out, &job, &packing, &result)?;
@@ -83,6 +70,26 @@ pub fn run(args: &PackArgs) -> anyhow::Result<()> {
         .row("wall time", format!("{:.1} s", record.wall_time))
         .row("output", out.display().to_string());
     table.print();
+    Ok(())
+}
+
+fn run_to_convergence(packing: &mut Packing, bar: &ProgressBar, job: &Path) -> anyhow::Result<()> {
+    loop {
+        let phase = packing.advance(STEPS_PER_UPDATE).with_context(|| format!("{}", job.display()))?;
+        let p = packing.progress();
+        bar.set_message(format!(
+            "{:<10} t = {:7.3} s  grains {:6} ({:3.0} % of the mass)  contacts {:7}",
+            p.phase.name(),
+            p.time,
+            p.grains,
+            100.0 * p.created,
+            p.contacts
+        ));
+        bar.tick();
+        if phase == Phase::Converged {
+            break;
+        }
+    }
     Ok(())
 }
 

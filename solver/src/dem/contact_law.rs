@@ -44,7 +44,8 @@ pub struct LinearSpringDashpot {
 pub struct ContactHistory {
     /// Tangential spring displacement δ_t of Eq. 7 (zero when the contact is open).
     pub tangential_displacement: Vector3<f64>,
-    /// Last contact normal, the warm start of the narrow phase (zero when the contact is open).
+    /// Last contact normal, or while apart the last separating direction found: the warm start
+    /// of the narrow phase (zero when unknown).
     pub normal: Vector3<f64>,
 }
 

@@ -33,19 +33,25 @@ impl Domain {
         }
     }
 
-    /// Maps a position into [0, L)² horizontally (periodic domain only).
-    pub fn wrap(&self, p: &mut Vector3<f64>) {
-        if let Domain::Periodic { width } = *self {
-            p.x = p.x.rem_euclid(width);
-            p.y = p.y.rem_euclid(width);
-            // rem_euclid can round up to exactly `width` for tiny negative inputs.
-            if p.x >= width {
-                p.x = 0.0;
+    /// Maps a position into [0, L)² horizontally (periodic domain only); returns the whole
+    /// periods taken off in x and y.
+    pub fn wrap(&self, p: &mut Vector3<f64>) -> [i32; 2] {
+        let Domain::Periodic { width } = *self else { return [0, 0] };
+        let mut periods = [0; 2];
+        for (k, period) in periods.iter_mut().enumerate() {
+            let mut n = (p[k] / width).floor();
+            p[k] -= n * width;
+            // Round-off can leave the result just outside [0, L).
+            if p[k] < 0.0 {
+                p[k] += width;
+                n -= 1.0;
+            } else if p[k] >= width {
+                p[k] -= width;
+                n += 1.0;
             }
-            if p.y >= width {
-                p.y = 0.0;
-            }
+            *period = n as i32;
         }
+        periods
     }
 
     /// The periodic image of j nearest to i, as whole periods to add to x_j in x and y.
@@ -57,6 +63,19 @@ impl Domain {
             }
             Domain::Cylinder { .. } => [0, 0],
         }
+    }
+
+    /// Every periodic image of j within `reach` of i along both periodic axes: the nearest one,
+    /// and its neighbour too when `reach` exceeds half the period (long grains in a narrow box).
+    pub fn images_within(&self, xi: &Vector3<f64>, xj: &Vector3<f64>, reach: f64) -> impl Iterator<Item = [i16; 2]> {
+        let nearest = self.nearest_image(xi, xj);
+        let l = self.width();
+        let axis = move |k: usize, d: f64| {
+            (-1..=1).map(move |s| nearest[k] + s).filter(move |&m| (d + m as f64 * l).abs() < reach)
+        };
+        let (dx, dy) = (xj.x - xi.x, xj.y - xi.y);
+        let periodic = self.is_periodic();
+        axis(0, dx).flat_map(move |mx| axis(1, dy).map(move |my| [mx, my])).filter(move |m| periodic || *m == [0, 0])
     }
 
     /// The offset of a periodic image.

@@ -28,6 +28,9 @@ pub struct NeighbourList {
     pub history: Vec<ContactHistory>,
     /// Positions at the last build; rebuilding is due once a body has moved skin/2 from here.
     reference: Vec<Vector3<f64>>,
+    /// Whole periods each body has been moved back into the box by since the start; a pair's
+    /// image corrected by them identifies the same contact across rebuilds.
+    wraps: Vec<[i32; 2]>,
     /// Per body, the range of `entries` listing its pairs: entry = 2·pair + (0 for i, 1 for j).
     offsets: Vec<u32>,
     entries: Vec<u32>,
@@ -43,6 +46,7 @@ struct Scratch {
     cell_of: Vec<usize>,
     old_pairs: Vec<Pair>,
     old_history: Vec<ContactHistory>,
+    old_keys: Vec<[i32; 2]>,
 }
 
 /// The cell grid of one build: periodic directions with fewer than three cells collapse to one,
@@ -112,6 +116,7 @@ impl NeighbourList {
             pairs: Vec::new(),
             history: Vec::new(),
             reference: Vec::new(),
+            wraps: Vec::new(),
             offsets: vec![0],
             entries: Vec::new(),
             builds: 0,
@@ -142,13 +147,19 @@ impl NeighbourList {
     /// Wraps positions into the periodic box, bins bodies into cells, lists the pairs within
     /// reach and carries each surviving pair's contact history over.
     pub fn rebuild(&mut self, bodies: &mut Bodies, domain: &Domain) -> Result<(), SolverError> {
-        for p in &mut bodies.position {
-            domain.wrap(p);
+        self.wraps.resize(bodies.len(), [0, 0]);
+        let old_keys: Vec<[i32; 2]> = self.pairs.iter().map(|p| contact_key(p, &self.wraps)).collect();
+        for (p, w) in bodies.position.iter_mut().zip(&mut self.wraps) {
+            let moved = domain.wrap(p);
+            w[0] += moved[0];
+            w[1] += moved[1];
         }
         let n = bodies.len();
         let r_max = bodies.bounding_radius.iter().cloned().fold(0.0, f64::max);
         let cutoff = 2.0 * r_max + self.skin;
-        if domain.is_periodic() && 2.0 * cutoff >= domain.width() {
+        // A grain must not reach its own periodic image; up to that, a pair may touch through
+        // two images at once and both are listed.
+        if domain.is_periodic() && cutoff >= domain.width() {
             return Err(SolverError::DomainTooNarrow { width: domain.width(), reach: cutoff });
         }
         let (z_lo, z_hi) =
@@ -177,6 +188,7 @@ impl NeighbourList {
 
         std::mem::swap(&mut self.pairs, &mut s.old_pairs);
         std::mem::swap(&mut self.history, &mut s.old_history);
+        s.old_keys = old_keys;
         self.pairs.clear();
         for i in 0..n {
             let xi = bodies.position[i];
@@ -191,28 +203,33 @@ impl NeighbourList {
                             if j <= i {
                                 continue;
                             }
-                            let image = domain.nearest_image(&xi, &bodies.position[j]);
                             let reach = bodies.bounding_radius[i] + bodies.bounding_radius[j] + self.skin;
-                            if (bodies.position[j] + domain.shift(image) - xi).norm_squared() < reach * reach {
-                                let (mi, mj) = (bodies.mass[i], bodies.mass[j]);
-                                let effective_mass = mi * mj / (mi + mj);
-                                self.pairs.push(Pair { i: i as u32, j: j as u32, image, effective_mass });
+                            let (mi, mj) = (bodies.mass[i], bodies.mass[j]);
+                            let effective_mass = mi * mj / (mi + mj);
+                            for image in domain.images_within(&xi, &bodies.position[j], reach) {
+                                if (bodies.position[j] + domain.shift(image) - xi).norm_squared() < reach * reach {
+                                    self.pairs.push(Pair { i: i as u32, j: j as u32, image, effective_mass });
+                                }
                             }
                         }
                     }
                 }
             }
         }
-        self.pairs.sort_unstable_by_key(|p| (p.i, p.j));
+        let wraps = &self.wraps;
+        self.pairs.sort_unstable_by_key(|p| (p.i, p.j, contact_key(p, wraps)));
 
-        // Merge by (i, j): both lists are sorted, so one pass carries the histories over.
+        // Merge by (i, j, contact key): both lists are sorted that way, so one pass carries the
+        // histories over.
         self.history.clear();
         let mut k = 0;
         for p in &self.pairs {
-            while k < s.old_pairs.len() && (s.old_pairs[k].i, s.old_pairs[k].j) < (p.i, p.j) {
+            let key = (p.i, p.j, contact_key(p, &self.wraps));
+            let old = |k: usize| (s.old_pairs[k].i, s.old_pairs[k].j, s.old_keys[k]);
+            while k < s.old_pairs.len() && old(k) < key {
                 k += 1;
             }
-            let same = k < s.old_pairs.len() && (s.old_pairs[k].i, s.old_pairs[k].j) == (p.i, p.j);
+            let same = k < s.old_pairs.len() && old(k) == key;
             self.history.push(if same { s.old_history[k] } else { ContactHistory::default() });
         }
 
@@ -239,5 +256,75 @@ impl NeighbourList {
         self.reference.extend_from_slice(&bodies.position);
         self.builds += 1;
         Ok(())
+    }
+}
+
+/// The image of a pair in unwrapped coordinates, image − W_j + W_i: unchanged by wrapping either
+/// body back into the box, so it names the same contact from one build to the next.
+fn contact_key(p: &Pair, wraps: &[[i32; 2]]) -> [i32; 2] {
+    let (wi, wj) = (wraps[p.i as usize], wraps[p.j as usize]);
+    [p.image[0] as i32 - wj[0] + wi[0], p.image[1] as i32 - wj[1] + wi[1]]
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{UnitQuaternion, Vector3};
+
+    use super::*;
+    use crate::dem::body::NewBody;
+    use crate::dem::shape::Shape;
+
+    fn bodies(positions: &[Vector3<f64>], shape: Shape) -> Bodies {
+        let mut b = Bodies::default();
+        for &position in positions {
+            let body = NewBody {
+                shape: shape.clone(),
+                position,
+                orientation: UnitQuaternion::identity(),
+                velocity: Vector3::zeros(),
+                angular_velocity: Vector3::zeros(),
+            };
+            b.push(body, 2650.0);
+        }
+        b
+    }
+
+    #[test]
+    fn a_contact_keeps_its_history_when_a_body_is_wrapped_into_the_box() {
+        let domain = Domain::Periodic { width: 0.05 };
+        let sphere = Shape::Sphere { radius: 3e-3 };
+        let mut b = bodies(&[Vector3::new(0.002, 0.02, 0.02), Vector3::new(0.0475, 0.02, 0.02)], sphere);
+        let mut list = NeighbourList::new(1e-3);
+        list.rebuild(&mut b, &domain).unwrap();
+        assert_eq!(list.pairs.len(), 1, "one pair, through the boundary");
+        list.history[0].tangential_displacement = Vector3::new(0.0, 1e-6, 0.0);
+        // Both drift by −3 mm: body 0 leaves through x = 0 and is wrapped to the far side.
+        for p in &mut b.position {
+            p.x -= 0.003;
+        }
+        list.rebuild(&mut b, &domain).unwrap();
+        assert!(b.position[0].x > 0.04, "body 0 was wrapped");
+        assert_eq!(list.pairs.len(), 1);
+        assert_eq!(list.history[0].tangential_displacement, Vector3::new(0.0, 1e-6, 0.0));
+    }
+
+    #[test]
+    fn a_long_grain_in_a_narrow_box_touches_a_neighbour_through_two_images() {
+        // Semi-axis 7 mm along x in a 20 mm box: grains 10 mm apart overlap directly and through
+        // the boundary; both contacts are listed, each once.
+        let domain = Domain::Periodic { width: 0.02 };
+        let needle = Shape::Ellipsoid { semi_axes: Vector3::new(7e-3, 2e-3, 2e-3) };
+        let mut b = bodies(&[Vector3::new(0.005, 0.01, 0.01), Vector3::new(0.015, 0.01, 0.01)], needle.clone());
+        let mut list = NeighbourList::new(5e-4);
+        list.rebuild(&mut b, &domain).unwrap();
+        let images: Vec<[i16; 2]> = list.pairs.iter().map(|p| p.image).collect();
+        assert_eq!(images, vec![[-1, 0], [0, 0]]);
+        // A grain reaching its own image is refused.
+        let mut long =
+            bodies(&[Vector3::new(0.01, 0.01, 0.01)], Shape::Ellipsoid { semi_axes: Vector3::new(0.0101, 2e-3, 2e-3) });
+        assert!(matches!(
+            NeighbourList::new(5e-4).rebuild(&mut long, &domain),
+            Err(SolverError::DomainTooNarrow { .. })
+        ));
     }
 }

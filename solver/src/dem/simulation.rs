@@ -202,9 +202,8 @@ impl Simulation {
                 let xj = bodies.position[j] + domain.shift(pair.image);
                 let a = Placed { shape: &bodies.shape[i], position: xi, pose: poses[i].as_ref() };
                 let b = Placed { shape: &bodies.shape[j], position: xj, pose: poses[j].as_ref() };
-                let warm = (history.normal != Vector3::zeros()).then_some(&history.normal);
-                let Some(geometry) = contact::between(&a, &b, warm) else {
-                    *history = ContactHistory::default();
+                let Some(geometry) = contact::between(&a, &b, &mut history.normal) else {
+                    history.tangential_displacement = Vector3::zeros();
                     *out = PairForce::default();
                     return (0, 0.0);
                 };
@@ -323,6 +322,6 @@ impl Simulation {
         let (pi, pj) = (pose(i), pose(j));
         let a = Placed { shape: &b.shape[i], position: b.position[i], pose: pi.as_ref() };
         let c = Placed { shape: &b.shape[j], position: b.position[j] + shift, pose: pj.as_ref() };
-        contact::between(&a, &c, None)
+        contact::between(&a, &c, &mut Vector3::zeros())
     }
 }

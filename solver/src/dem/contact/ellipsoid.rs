@@ -148,7 +148,7 @@ impl EllipsoidPose {
 }
 
 /// How one ellipsoid–ellipsoid query was answered, for diagnostics and tests.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SolveStats {
     /// Newton iterations summed over all starts.
     pub newton_iterations: u32,
@@ -157,6 +157,9 @@ pub struct SolveStats {
     /// The answer is proven: a separating direction was found, or the minimum lies below the
     /// rolling-ball bound (module docs). Only deep overlaps can end uncertified.
     pub certified: bool,
+    /// A direction n with f(n) < 0 when one proved the pair apart: the best warm start for the
+    /// next step's query of the same pair.
+    pub separating: Option<Vector3<f64>>,
 }
 
 /// Contact of two ellipsoids, or `None` when they do not overlap (issue 3, item 3).
@@ -277,7 +280,7 @@ impl End {
 
 enum Descent {
     /// A direction with f < 0 was met: the bodies do not overlap.
-    Separated,
+    Separated(Vector3<f64>),
     Stopped {
         end: End,
         converged: bool,
@@ -308,8 +311,9 @@ impl Pair<'_> {
         let mut best: Option<End> = None;
         for start in [warm.and_then(unit), unit(&self.d)].into_iter().flatten() {
             match self.descend(start, stats) {
-                Descent::Separated => {
+                Descent::Separated(n) => {
                     stats.certified = true;
+                    stats.separating = Some(n);
                     return None;
                 }
                 Descent::Stopped { end, converged } => {
@@ -327,6 +331,7 @@ impl Pair<'_> {
             let (up, down) = (self.value(&direction), self.value(&-direction));
             if up.min(down) < 0.0 {
                 stats.certified = true;
+                stats.separating = Some(if up < down { direction } else { -direction });
                 return None;
             }
             // Lower first, so that the swapped pair (which sees the two values exchanged) builds
@@ -341,8 +346,9 @@ impl Pair<'_> {
         }
         for start in &candidates.n[..candidates.len] {
             match self.descend(*start, stats) {
-                Descent::Separated => {
+                Descent::Separated(n) => {
                     stats.certified = true;
+                    stats.separating = Some(n);
                     return None;
                 }
                 Descent::Stopped { end, converged } => {
@@ -361,7 +367,7 @@ impl Pair<'_> {
     fn descend(&self, start: Vector3<f64>, stats: &mut SolveStats) -> Descent {
         let mut at = self.sample(start);
         if at.f < 0.0 {
-            return Descent::Separated;
+            return Descent::Separated(at.n);
         }
         // Length of the last full Newton step, which tells how fast the run contracts.
         let mut previous: Option<f64> = None;
@@ -384,7 +390,7 @@ impl Pair<'_> {
             loop {
                 let trial = self.sample((at.n + step * fraction).normalize());
                 if trial.f < 0.0 {
-                    return Descent::Separated;
+                    return Descent::Separated(trial.n);
                 }
                 if trial.f <= at.f + ARMIJO * fraction * slope + slack {
                     at = trial;

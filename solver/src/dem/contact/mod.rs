@@ -43,9 +43,11 @@ impl Placed<'_> {
     }
 }
 
-/// Contact of body A with body B; `warm` is the pair's normal at the previous step, if any.
+/// Contact of body A with body B. `warm` carries a direction from one step to the next: on
+/// entry the pair's last contact normal or separating direction (zero if none), on exit the
+/// one found now (zero if none), so that both touching and merely close pairs start warm.
 #[inline(always)]
-pub fn between(a: &Placed, b: &Placed, warm: Option<&Vector3<f64>>) -> Option<ContactGeometry> {
+pub fn between(a: &Placed, b: &Placed, warm: &mut Vector3<f64>) -> Option<ContactGeometry> {
     match (a.shape, b.shape) {
         (Shape::Sphere { radius: ra }, Shape::Sphere { radius: rb }) => {
             sphere::sphere_sphere(&a.position, *ra, &b.position, *rb)
@@ -56,8 +58,15 @@ pub fn between(a: &Placed, b: &Placed, warm: Option<&Vector3<f64>>) -> Option<Co
 
 /// The non-spherical pairs, kept out of line so that the sphere path stays small.
 #[inline(never)]
-fn curved(a: &Placed, b: &Placed, warm: Option<&Vector3<f64>>) -> Option<ContactGeometry> {
-    ellipsoid::ellipsoid_ellipsoid(&a.ellipsoid(), &b.ellipsoid(), warm)
+fn curved(a: &Placed, b: &Placed, warm: &mut Vector3<f64>) -> Option<ContactGeometry> {
+    let start = (*warm != Vector3::zeros()).then_some(*warm);
+    let (contact, stats) = ellipsoid::ellipsoid_ellipsoid_with_stats(&a.ellipsoid(), &b.ellipsoid(), start.as_ref());
+    *warm = match (&contact, stats.separating) {
+        (Some(c), _) => c.normal,
+        (None, Some(n)) => n,
+        (None, None) => Vector3::zeros(),
+    };
+    contact
 }
 
 /// Contact of a body with the floor z = 0.
