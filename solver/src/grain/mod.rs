@@ -1,7 +1,9 @@
 //! Everything about a single grain and a population of grains: form parameters and factors
 //! (§2, Table 1), meshes and their mass-equivalent ellipsoid (Appendix A), sizes from sieve
-//! curves (§3.2, Table 3), form distributions (§7.1, §7.3) and generated pebble meshes.
+//! curves (§3.2, Table 3), form distributions (§7.1, §7.3), generated pebble meshes and the
+//! bonded-sphere grains of the second paper (its §2.4 and Appendix).
 
+pub mod bonded;
 pub mod ellipsoid;
 pub mod form;
 pub mod form_distribution;
@@ -10,6 +12,10 @@ pub mod pebble;
 pub mod size;
 pub mod unit_mesh;
 
+pub use bonded::{
+    BondedGrain, ComponentSphere, EQUANT_EPSILON, SolidMass, ZinggClass, bonded_grain, construction, ellipsoid_mass,
+    sphere_mass_properties,
+};
 pub use ellipsoid::EquivalentEllipsoid;
 pub use form::{
     FactorValue, FormError, FormFactor, FormFactors, FormParameters, FormStatistic, Undefined, feature_names,
