@@ -74,6 +74,27 @@ fn forms_mesh_gives_the_box_axes() {
 }
 
 #[test]
+fn forms_bonded_builds_the_rod_of_three_spheres() {
+    // L = 3, I = S = 1 is a rod (I/L < 2/3, S/I > 2/3): a row of spheres of diameter
+    // sqrt(S·I) = 1 spanning L, i.e. three touching unit spheres centred at −1, 0, 1 (§2.4);
+    // volume 3·π/6 = π/2, like the ellipsoid π·3·1·1/6, and I_x = 3·(2/5)(π/6)(1/2)² = π/20.
+    let v = json(&["forms", "--bonded", "3", "1", "1", "--json"]);
+    assert_eq!(v["class"], "rod");
+    let spheres = v["spheres"].as_array().unwrap();
+    assert_eq!(spheres.len(), 3);
+    let mut xs: Vec<f64> = spheres.iter().map(|s| s["center"][0].as_f64().unwrap()).collect();
+    xs.sort_by(f64::total_cmp);
+    for (x, want) in xs.iter().zip([-1.0, 0.0, 1.0]) {
+        assert!((x - want).abs() < 1e-12);
+    }
+    let pi = std::f64::consts::PI;
+    assert!((v["volume"].as_f64().unwrap() - pi / 2.0).abs() < 1e-12);
+    assert!((v["ellipsoid"]["volume"].as_f64().unwrap() - pi / 2.0).abs() < 1e-12);
+    assert!((v["inertia"][0].as_f64().unwrap() - pi / 20.0).abs() < 1e-12);
+    fails(&["forms", "--bonded", "1", "2", "1"], &["--bonded", "L ≥ I ≥ S"]);
+}
+
+#[test]
 fn forms_of_a_distribution_give_equancy_statistics() {
     let v = json(&[
         "forms",

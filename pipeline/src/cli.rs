@@ -176,7 +176,7 @@ pub struct DistributionArgs {
 }
 
 #[derive(Debug, Args)]
-#[command(group(ArgGroup::new("input").required(true).args(["lis", "mesh", "mu_fl"])))]
+#[command(group(ArgGroup::new("input").required(true).args(["lis", "mesh", "mu_fl", "bonded"])))]
 pub struct FormsArgs {
     /// Long, intermediate and short axes (L ≥ I ≥ S > 0, any length unit).
     #[arg(long, num_args = 3, value_names = ["L", "I", "S"], allow_negative_numbers = true)]
@@ -184,6 +184,10 @@ pub struct FormsArgs {
     /// A closed triangle mesh (STL or OBJ); its form is that of its mass-equivalent ellipsoid.
     #[arg(long)]
     pub mesh: Option<PathBuf>,
+    /// The bonded-sphere grain of Sun & Xiao built for axes L ≥ I ≥ S: its Zingg class, component
+    /// spheres and mass properties beside those of the ellipsoid with the same axes.
+    #[arg(long, num_args = 3, value_names = ["L", "I", "S"], allow_negative_numbers = true)]
+    pub bonded: Option<Vec<f64>>,
     /// Mean flatness μ_FL of a form distribution (with --sigma-fl, --mu-el, --sigma-el).
     #[arg(long, allow_negative_numbers = true, requires_all = ["sigma_fl", "mu_el", "sigma_el"])]
     pub mu_fl: Option<f64>,

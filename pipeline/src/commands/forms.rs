@@ -2,7 +2,7 @@
 
 use anyhow::Context;
 use serde_json::{Map, Value, json};
-use solver::grain::{EquivalentEllipsoid, FormDistribution, FormParameters, TriMesh};
+use solver::grain::{EquivalentEllipsoid, FormDistribution, FormParameters, TriMesh, bonded_grain, ellipsoid_mass};
 
 use crate::cli::{DistributionArgs, FormsArgs};
 use crate::output::{Table, number, print_json};
@@ -22,8 +22,11 @@ pub fn run(args: &FormsArgs) -> anyhow::Result<()> {
             json!([props.center_of_mass.x, props.center_of_mass.y, props.center_of_mass.z]),
         );
         (record, format!("mesh {}", path.display()))
+    } else if let Some(lis) = &args.bonded {
+        let form = FormParameters::new(lis[0], lis[1], lis[2]).context("--bonded")?;
+        (bonded_record(&form)?, "bonded-sphere grain (Sun & Xiao, §2.4 and Appendix)".to_string())
     } else {
-        let d = args.distribution().expect("clap requires --lis, --mesh or the distribution");
+        let d = args.distribution().expect("clap requires --lis, --mesh, --bonded or the distribution");
         (distribution_record(&d)?, "form distribution (§7.1, §7.3)".to_string())
     };
     if args.json {
@@ -35,6 +38,7 @@ pub fn run(args: &FormsArgs) -> anyhow::Result<()> {
         match value {
             Value::Number(n) => table.row(key, number(n.as_f64().unwrap_or(f64::NAN))),
             Value::Null => table.row(key, "undefined"),
+            Value::String(text) => table.row(key, text.clone()),
             Value::Array(items) if key == "notes" => {
                 items.iter().for_each(|n| {
                     table.row("note", n.as_str().unwrap_or_default());
@@ -43,8 +47,21 @@ pub fn run(args: &FormsArgs) -> anyhow::Result<()> {
             }
             Value::Object(inner) => {
                 for (k, v) in inner {
-                    table.row(format!("{key}.{k}"), number(v.as_f64().unwrap_or(f64::NAN)));
+                    table.row(format!("{key}.{k}"), v.as_f64().map_or_else(|| v.to_string(), number));
                 }
+                &mut table
+            }
+            Value::Array(items) if key == "spheres" => {
+                items.iter().for_each(|sphere| {
+                    table.row(
+                        "sphere",
+                        format!(
+                            "centre {} radius {}",
+                            sphere["center"],
+                            number(sphere["radius"].as_f64().unwrap_or(f64::NAN))
+                        ),
+                    );
+                });
                 &mut table
             }
             other => table.row(key, other.to_string()),
@@ -76,6 +93,31 @@ pub fn grain_record(form: &FormParameters, volume: f64) -> Map<String, Value> {
     }
     record.insert("notes".into(), json!(notes));
     record
+}
+
+/// The class, component spheres (grain frame, centre of mass at the origin), volume and
+/// principal moments (per unit density, ascending), beside the ellipsoid with full axes L, I, S.
+fn bonded_record(form: &FormParameters) -> anyhow::Result<Map<String, Value>> {
+    let grain = bonded_grain(form)?;
+    let ellipsoid = ellipsoid_mass(form);
+    let mut record = Map::new();
+    record.insert("L".into(), json!(form.l));
+    record.insert("I".into(), json!(form.i));
+    record.insert("S".into(), json!(form.s));
+    record.insert("class".into(), json!(grain.class.name()));
+    let spheres: Vec<Value> = grain
+        .spheres
+        .iter()
+        .map(|c| json!({"center": [c.center.x, c.center.y, c.center.z], "radius": c.radius}))
+        .collect();
+    record.insert("spheres".into(), json!(spheres));
+    record.insert("volume".into(), json!(grain.volume));
+    record.insert("inertia".into(), json!([grain.inertia.x, grain.inertia.y, grain.inertia.z]));
+    record.insert(
+        "ellipsoid".into(),
+        json!({"volume": ellipsoid.volume, "inertia": [ellipsoid.inertia.x, ellipsoid.inertia.y, ellipsoid.inertia.z]}),
+    );
+    Ok(record)
 }
 
 fn distribution_record(d: &DistributionArgs) -> anyhow::Result<Map<String, Value>> {
