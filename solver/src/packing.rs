@@ -13,7 +13,9 @@ use thiserror::Error;
 
 use crate::SolverError;
 use crate::dem::{Calibration, Domain, NewBody, Settings, Shaking, Shape, Simulation};
-use crate::grain::{FormDistribution, FormParameters, FormStatistic, SieveCurve, SizeSampler, form_statistics};
+use crate::grain::{
+    FormDistribution, FormParameters, FormStatistic, SieveCurve, SizeSampler, bonded_grain, form_statistics,
+};
 use crate::porosity::{self, Porosity, PorosityError, PorositySettings};
 
 /// Material constants of §4.2.
@@ -47,6 +49,8 @@ impl Default for Material {
 pub enum ShapeKind {
     Sphere,
     Ellipsoid,
+    /// The bonded-sphere grain of Sun & Xiao (§2.4) built for each grain's L, I, S.
+    BondedSpheres,
 }
 
 /// How each grain's form is chosen.
@@ -329,6 +333,9 @@ impl Packing {
             let shape = match spec.grains.shape {
                 ShapeKind::Sphere => Shape::Sphere { radius: size / 2.0 },
                 ShapeKind::Ellipsoid => Shape::Ellipsoid { semi_axes: Vector3::new(form.l, form.i, form.s) / 2.0 },
+                ShapeKind::BondedSpheres => {
+                    Shape::from(&bonded_grain(&form).expect("sampled forms satisfy L ≥ I ≥ S > 0"))
+                }
             };
             let orientation = random_rotation(&mut self.rng);
             let mut spin = || self.rng.random_range(-0.1..0.1) * u;

@@ -2,7 +2,7 @@
 //! bounding spheres come within a skin distance; the list is reused until some body has moved
 //! more than half the skin, and each pair carries its contact history across rebuilds.
 
-use nalgebra::Vector3;
+use nalgebra::{UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
 use super::body::Bodies;
@@ -10,13 +10,16 @@ use super::contact_law::ContactHistory;
 use super::domain::Domain;
 use crate::SolverError;
 
-/// Two bodies i < j whose bounding spheres, with j moved by whole periods `image` (its periodic
-/// image nearest to i), are closer than the skin.
+/// A piece of body i and a piece of body j > i (with j moved by whole periods `image`, a
+/// periodic image within reach of i) that are closer than the skin: one possible contact. Two
+/// convex grains have one piece each; a bonded grain one per component sphere.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Pair {
     pub i: u32,
     pub j: u32,
     pub image: [i16; 2],
+    /// Piece of i and piece of j.
+    pub pieces: [u16; 2],
     /// m_i m_j / (m_i + m_j), the mass of Eq. 11, kept here to spare a division per step.
     pub effective_mass: f64,
 }
@@ -25,14 +28,19 @@ pub struct Pair {
 pub struct NeighbourList {
     skin: f64,
     pub pairs: Vec<Pair>,
+    /// The contact history of each pair.
     pub history: Vec<ContactHistory>,
     /// Positions at the last build; rebuilding is due once a body has moved skin/2 from here.
     reference: Vec<Vector3<f64>>,
+    /// Orientations at the last build: the pieces of a bonded grain also move by turning.
+    reference_orientation: Vec<UnitQuaternion<f64>>,
     /// Whole periods each body has been moved back into the box by since the start; a pair's
     /// image corrected by them identifies the same contact across rebuilds.
     wraps: Vec<[i32; 2]>,
-    /// Per body, the range of `entries` listing its pairs: entry = 2·pair + (0 for i, 1 for j).
+    /// Per body b, `entries[offsets[b]..split[b]]` are the pairs where it is i and
+    /// `entries[split[b]..offsets[b + 1]]` those where it is j: two loops without a branch.
     offsets: Vec<u32>,
+    split: Vec<u32>,
     entries: Vec<u32>,
     pub builds: u64,
     #[serde(skip)]
@@ -116,8 +124,10 @@ impl NeighbourList {
             pairs: Vec::new(),
             history: Vec::new(),
             reference: Vec::new(),
+            reference_orientation: Vec::new(),
             wraps: Vec::new(),
             offsets: vec![0],
+            split: Vec::new(),
             entries: Vec::new(),
             builds: 0,
             scratch: Scratch::default(),
@@ -128,20 +138,29 @@ impl NeighbourList {
         self.skin
     }
 
-    /// A rebuild is due when bodies were added or one moved more than half the skin, the most
-    /// two bodies can approach each other without the list noticing.
+    /// A rebuild is due when bodies were added or a piece moved more than half the skin, the
+    /// most two pieces can approach each other without the list noticing. A bonded grain's
+    /// pieces move by at most |Δx| + r θ for a turn by θ.
     pub fn is_stale(&self, bodies: &Bodies) -> bool {
         if self.reference.len() != bodies.len() {
             return true;
         }
         let limit = 0.25 * self.skin * self.skin;
-        bodies.position.iter().zip(&self.reference).any(|(p, r)| (p - r).norm_squared() > limit)
+        (0..bodies.len()).any(|k| {
+            let shift2 = (bodies.position[k] - self.reference[k]).norm_squared();
+            if bodies.shape[k].pieces() == 1 {
+                return shift2 > limit;
+            }
+            let turn = bodies.orientation[k].angle_to(&self.reference_orientation[k]);
+            shift2.sqrt() + bodies.bounding_radius[k] * turn > 0.5 * self.skin
+        })
     }
 
-    /// Pairs of body `b`, as entries 2·pair + side.
+    /// Pairs of body `b`: those where it is i, and those where it is j.
     #[inline]
-    pub fn entries_of(&self, b: usize) -> &[u32] {
-        &self.entries[self.offsets[b] as usize..self.offsets[b + 1] as usize]
+    pub fn pairs_of(&self, b: usize) -> (&[u32], &[u32]) {
+        let (start, split, end) = (self.offsets[b] as usize, self.split[b] as usize, self.offsets[b + 1] as usize);
+        (&self.entries[start..split], &self.entries[split..end])
     }
 
     /// Wraps positions into the periodic box, bins bodies into cells, lists the pairs within
@@ -207,8 +226,10 @@ impl NeighbourList {
                             let (mi, mj) = (bodies.mass[i], bodies.mass[j]);
                             let effective_mass = mi * mj / (mi + mj);
                             for image in domain.images_within(&xi, &bodies.position[j], reach) {
-                                if (bodies.position[j] + domain.shift(image) - xi).norm_squared() < reach * reach {
-                                    self.pairs.push(Pair { i: i as u32, j: j as u32, image, effective_mass });
+                                let xj = bodies.position[j] + domain.shift(image);
+                                if (xj - xi).norm_squared() < reach * reach {
+                                    let body_pair = Pair { i: i as u32, j: j as u32, image, pieces: [0, 0], effective_mass };
+                                    push_piece_pairs(&mut self.pairs, body_pair, bodies, xj, self.skin);
                                 }
                             }
                         }
@@ -217,15 +238,15 @@ impl NeighbourList {
             }
         }
         let wraps = &self.wraps;
-        self.pairs.sort_unstable_by_key(|p| (p.i, p.j, contact_key(p, wraps)));
+        self.pairs.sort_unstable_by_key(|p| (p.i, p.j, contact_key(p, wraps), p.pieces));
 
-        // Merge by (i, j, contact key): both lists are sorted that way, so one pass carries the
-        // histories over.
+        // Merge by (i, j, contact key, pieces): both lists are sorted that way, so one pass
+        // carries the histories over.
         self.history.clear();
         let mut k = 0;
         for p in &self.pairs {
-            let key = (p.i, p.j, contact_key(p, &self.wraps));
-            let old = |k: usize| (s.old_pairs[k].i, s.old_pairs[k].j, s.old_keys[k]);
+            let key = (p.i, p.j, contact_key(p, &self.wraps), p.pieces);
+            let old = |k: usize| (s.old_pairs[k].i, s.old_pairs[k].j, s.old_keys[k], s.old_pairs[k].pieces);
             while k < s.old_pairs.len() && old(k) < key {
                 k += 1;
             }
@@ -246,16 +267,43 @@ impl NeighbourList {
         self.entries.resize(2 * self.pairs.len(), 0);
         let mut next: Vec<u32> = self.offsets[..n].to_vec();
         for (k, p) in self.pairs.iter().enumerate() {
-            for (side, b) in [(0, p.i), (1, p.j)] {
-                self.entries[next[b as usize] as usize] = 2 * k as u32 + side;
-                next[b as usize] += 1;
-            }
+            self.entries[next[p.i as usize] as usize] = k as u32;
+            next[p.i as usize] += 1;
+        }
+        self.split.clone_from(&next);
+        for (k, p) in self.pairs.iter().enumerate() {
+            self.entries[next[p.j as usize] as usize] = k as u32;
+            next[p.j as usize] += 1;
         }
 
         self.reference.clear();
         self.reference.extend_from_slice(&bodies.position);
+        self.reference_orientation.clear();
+        self.reference_orientation.extend_from_slice(&bodies.orientation);
         self.builds += 1;
         Ok(())
+    }
+}
+
+/// The piece pairs of a body pair whose pieces come within the skin: the one pair of two convex
+/// grains, those of nearby component spheres when a grain is bonded.
+fn push_piece_pairs(pairs: &mut Vec<Pair>, body_pair: Pair, bodies: &Bodies, xj: Vector3<f64>, skin: f64) {
+    let (i, j) = (body_pair.i as usize, body_pair.j as usize);
+    let (si, sj) = (&bodies.shape[i], &bodies.shape[j]);
+    if si.pieces() == 1 && sj.pieces() == 1 {
+        pairs.push(body_pair);
+        return;
+    }
+    for ka in 0..si.pieces() {
+        let (ca, ra) = si.piece_bounds(ka);
+        let ca = bodies.position[i] + bodies.orientation[i] * ca;
+        for kb in 0..sj.pieces() {
+            let (cb, rb) = sj.piece_bounds(kb);
+            let reach = ra + rb + skin;
+            if (xj + bodies.orientation[j] * cb - ca).norm_squared() < reach * reach {
+                pairs.push(Pair { pieces: [ka as u16, kb as u16], ..body_pair });
+            }
+        }
     }
 }
 

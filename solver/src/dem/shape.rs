@@ -1,11 +1,13 @@
 //! Grain shapes as rigid bodies: volume, principal moments of inertia and bounding sphere, all
-//! in the body frame, whose axes are the principal axes of inertia.
+//! in the body frame, whose axes are the principal axes of inertia; and the convex pieces the
+//! narrow phase meets (one for a convex grain, one per component sphere of a bonded grain).
 
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
+use super::contact::Piece;
 use super::contact::ellipsoid::EllipsoidPose;
-use crate::grain::FormParameters;
+use crate::grain::{BondedGrain, ComponentSphere, FormParameters};
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum Shape {
@@ -16,6 +18,33 @@ pub enum Shape {
     Ellipsoid {
         semi_axes: Vector3<f64>,
     },
+    /// Rigidly bonded, non-overlapping spheres (Sun & Xiao §2.4) in the principal-axes frame with
+    /// the centre of mass at the origin; contacts are those of the component spheres.
+    Bonded(Box<Bonded>),
+}
+
+/// The component spheres of a bonded grain with its mass properties, precomputed once.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Bonded {
+    pub spheres: Vec<ComponentSphere>,
+    pub volume: f64,
+    /// Principal moments per unit density along the body axes.
+    pub inertia: Vector3<f64>,
+    pub bounding_radius: f64,
+    /// The axes the grain was built for.
+    pub form: FormParameters,
+}
+
+impl From<&BondedGrain> for Shape {
+    fn from(grain: &BondedGrain) -> Self {
+        Shape::Bonded(Box::new(Bonded {
+            spheres: grain.spheres.clone(),
+            volume: grain.volume,
+            inertia: grain.inertia,
+            bounding_radius: grain.bounding_radius,
+            form: grain.form,
+        }))
+    }
 }
 
 impl Shape {
@@ -24,6 +53,7 @@ impl Shape {
         match self {
             Shape::Sphere { radius } => four_thirds_pi * radius.powi(3),
             Shape::Ellipsoid { semi_axes: s } => four_thirds_pi * s.x * s.y * s.z,
+            Shape::Bonded(b) => b.volume,
         }
     }
 
@@ -36,6 +66,7 @@ impl Shape {
                 let (a2, b2, c2) = (s.x * s.x, s.y * s.y, s.z * s.z);
                 Vector3::new(b2 + c2, a2 + c2, a2 + b2) * (m / 5.0)
             }
+            Shape::Bonded(b) => b.inertia * density,
         }
     }
 
@@ -44,50 +75,89 @@ impl Shape {
         match self {
             Shape::Sphere { radius } => *radius,
             Shape::Ellipsoid { semi_axes } => semi_axes.max(),
+            Shape::Bonded(b) => b.bounding_radius,
         }
     }
 
-    /// Smallest half-thickness, the scale against which overlaps are judged.
-    pub fn smallest_half_extent(&self) -> f64 {
-        match self {
-            Shape::Sphere { radius } => *radius,
-            Shape::Ellipsoid { semi_axes } => semi_axes.min(),
-        }
-    }
-
-    /// L, I, S of the shape (full axes of its mass-equivalent ellipsoid, which for a sphere or an
-    /// ellipsoid is the shape itself).
+    /// L, I, S of the shape: the full axes of a sphere or ellipsoid, the axes a bonded grain was
+    /// built for.
     pub fn form(&self) -> FormParameters {
         match self {
             Shape::Sphere { radius } => FormParameters { l: 2.0 * radius, i: 2.0 * radius, s: 2.0 * radius },
             Shape::Ellipsoid { semi_axes } => {
                 FormParameters::from_unsorted((2.0 * semi_axes).into()).expect("positive semi-axes")
             }
+            Shape::Bonded(b) => b.form,
         }
     }
 
-    /// A triangulated surface in the body frame, for visualisation: the unit icosphere subdivided
-    /// `level` times, stretched to the shape.
-    pub fn surface(&self, level: usize) -> (Vec<Vector3<f64>>, Vec<[u32; 3]>) {
-        let (mut vertices, triangles) = unit_icosphere(level);
-        let scale = match self {
-            Shape::Sphere { radius } => Vector3::repeat(*radius),
-            Shape::Ellipsoid { semi_axes } => *semi_axes,
-        };
-        for v in &mut vertices {
-            *v = v.component_mul(&scale);
+    /// Number of convex pieces the narrow phase meets.
+    #[inline]
+    pub fn pieces(&self) -> usize {
+        match self {
+            Shape::Bonded(b) => b.spheres.len(),
+            _ => 1,
         }
-        (vertices, triangles)
+    }
+
+    /// Piece `k` of a body at `position` turned by `orientation` (with its ellipsoid `pose` for
+    /// an ellipsoid).
+    #[inline]
+    pub fn piece<'a>(
+        &'a self,
+        k: usize,
+        position: Vector3<f64>,
+        orientation: &UnitQuaternion<f64>,
+        pose: Option<&'a EllipsoidPose>,
+    ) -> Piece<'a> {
+        match (self, pose) {
+            (Shape::Sphere { radius }, _) => Piece::Sphere { center: position, radius: *radius },
+            (Shape::Ellipsoid { .. }, Some(pose)) => Piece::Ellipsoid { pose, center: position },
+            (Shape::Ellipsoid { .. }, None) => unreachable!("an ellipsoid body always has a pose"),
+            (Shape::Bonded(b), _) => {
+                let c = &b.spheres[k];
+                Piece::Sphere { center: position + orientation * c.center, radius: c.radius }
+            }
+        }
+    }
+
+    /// Centre (body frame) and bounding radius of piece `k`.
+    pub fn piece_bounds(&self, k: usize) -> (Vector3<f64>, f64) {
+        match self {
+            Shape::Bonded(b) => (b.spheres[k].center, b.spheres[k].radius),
+            _ => (Vector3::zeros(), self.bounding_radius()),
+        }
+    }
+
+    /// A triangulated surface in the body frame, for visualisation: unit icospheres subdivided
+    /// `level` times, stretched to the shape (one per component sphere of a bonded grain).
+    pub fn surface(&self, level: usize) -> (Vec<Vector3<f64>>, Vec<[u32; 3]>) {
+        let (unit, triangles) = unit_icosphere(level);
+        let stretched = |scale: Vector3<f64>, offset: Vector3<f64>| unit.iter().map(move |v| offset + v.component_mul(&scale));
+        match self {
+            Shape::Sphere { radius } => (stretched(Vector3::repeat(*radius), Vector3::zeros()).collect(), triangles),
+            Shape::Ellipsoid { semi_axes } => (stretched(*semi_axes, Vector3::zeros()).collect(), triangles),
+            Shape::Bonded(b) => {
+                let mut vertices = Vec::with_capacity(unit.len() * b.spheres.len());
+                let mut all = Vec::with_capacity(triangles.len() * b.spheres.len());
+                for c in &b.spheres {
+                    let offset = vertices.len() as u32;
+                    vertices.extend(stretched(Vector3::repeat(c.radius), c.center));
+                    all.extend(triangles.iter().map(|t| t.map(|v| v + offset)));
+                }
+                (vertices, all)
+            }
+        }
     }
 
     /// The precomputed ellipsoid of the narrow phase for a body at `position` turned by
-    /// `orientation`; None for spheres, whose contacts are analytic.
+    /// `orientation`; None for shapes met as spheres.
     pub fn pose(&self, position: Vector3<f64>, orientation: &UnitQuaternion<f64>) -> Option<EllipsoidPose> {
         match self {
-            Shape::Sphere { .. } => None,
             Shape::Ellipsoid { semi_axes } => {
                 Some(EllipsoidPose::new(position, orientation.to_rotation_matrix().matrix(), *semi_axes))
             }
+            _ => None,
         }
     }
 

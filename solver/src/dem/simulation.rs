@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use super::body::{Bodies, NewBody};
 use super::contact::ellipsoid::EllipsoidPose;
-use super::contact::{self, ContactGeometry, Placed};
+use super::contact::{self, ContactGeometry};
 use super::contact_law::{Calibration, ContactHistory, LinearSpringDashpot};
 use super::domain::Domain;
 use super::neighbours::NeighbourList;
@@ -83,8 +83,9 @@ pub struct Simulation {
     pub settings: Settings,
     law: LinearSpringDashpot,
     neighbours: NeighbourList,
-    floor_history: Vec<ContactHistory>,
-    wall_history: Vec<ContactHistory>,
+    /// Per body, the history of each piece's contact with the floor and with the cylinder wall.
+    floor_history: Vec<Vec<ContactHistory>>,
+    wall_history: Vec<Vec<ContactHistory>>,
     pub time: f64,
     pub steps: u64,
     /// Shaking force applied in the current phase, if any.
@@ -140,8 +141,8 @@ impl Simulation {
     }
 
     pub fn add_body(&mut self, body: NewBody) -> usize {
-        self.floor_history.push(ContactHistory::default());
-        self.wall_history.push(ContactHistory::default());
+        self.floor_history.push(vec![ContactHistory::default(); body.shape.pieces()]);
+        self.wall_history.push(vec![ContactHistory::default(); body.shape.pieces()]);
         self.refresh_poses();
         self.poses.push(body.shape.pose(body.position, &body.orientation));
         self.bodies.push(body, self.settings.density)
@@ -200,8 +201,9 @@ impl Simulation {
                 let (i, j) = (pair.i as usize, pair.j as usize);
                 let xi = bodies.position[i];
                 let xj = bodies.position[j] + domain.shift(pair.image);
-                let a = Placed { shape: &bodies.shape[i], position: xi, pose: poses[i].as_ref() };
-                let b = Placed { shape: &bodies.shape[j], position: xj, pose: poses[j].as_ref() };
+                let [ka, kb] = pair.pieces.map(usize::from);
+                let a = bodies.shape[i].piece(ka, xi, &bodies.orientation[i], poses[i].as_ref());
+                let b = bodies.shape[j].piece(kb, xj, &bodies.orientation[j], poses[j].as_ref());
                 let Some(geometry) = contact::between(&a, &b, &mut history.normal) else {
                     history.tangential_displacement = Vector3::zeros();
                     *out = PairForce::default();
@@ -212,7 +214,7 @@ impl Simulation {
                 let relative = bodies.point_velocity(j, &arm_j) - bodies.point_velocity(i, &arm_i);
                 let force = law.force(pair.effective_mass, &geometry, &relative, history, dt);
                 *out = PairForce { force, torque_i: force.cross(&arm_i), torque_j: arm_j.cross(&force) };
-                let scale = bodies.shape[i].smallest_half_extent().min(bodies.shape[j].smallest_half_extent());
+                let scale = a.smallest_half_extent().min(b.smallest_half_extent());
                 (1, geometry.depth / scale)
             })
             .reduce(|| (0, 0.0), |a, b| (a.0 + b.0, a.1.max(b.1)))
@@ -248,32 +250,35 @@ impl Simulation {
                 let mass = b.mass[k];
                 let mut force = weight_per_volume * b.volume[k] + Vector3::new(mass * shaking, 0.0, 0.0);
                 let mut torque = Vector3::zeros();
-                for &entry in neighbours.entries_of(k) {
-                    let pf = &pair_forces[(entry / 2) as usize];
-                    if entry % 2 == 0 {
-                        force -= pf.force;
-                        torque += pf.torque_i;
-                    } else {
-                        force += pf.force;
-                        torque += pf.torque_j;
-                    }
+                let (as_i, as_j) = neighbours.pairs_of(k);
+                for &pair in as_i {
+                    let pf = &pair_forces[pair as usize];
+                    force -= pf.force;
+                    torque += pf.torque_i;
                 }
-                let placed = Placed { shape, position: *x, pose: pose.as_ref() };
+                for &pair in as_j {
+                    let pf = &pair_forces[pair as usize];
+                    force += pf.force;
+                    torque += pf.torque_j;
+                }
                 let mut wall_contacts = 0;
-                for (geometry, history) in
-                    [(contact::with_floor(&placed), &mut *floor), (contact::with_wall(&placed, &domain), &mut *wall)]
-                {
-                    let Some(g) = geometry else {
-                        *history = ContactHistory::default();
-                        continue;
-                    };
-                    // The wall is body B, immovable: m_eff = m and its velocity is zero.
-                    let arm = g.point - *x;
-                    let relative = -(*v + w.cross(&arm));
-                    let f = -law.force(mass, &g, &relative, history, dt);
-                    force += f;
-                    torque += arm.cross(&f);
-                    wall_contacts += 1;
+                for (k, (floor, wall)) in floor.iter_mut().zip(wall.iter_mut()).enumerate() {
+                    let piece = shape.piece(k, *x, q, pose.as_ref());
+                    for (geometry, history) in
+                        [(contact::with_floor(&piece), &mut *floor), (contact::with_wall(&piece, &domain), &mut *wall)]
+                    {
+                        let Some(g) = geometry else {
+                            *history = ContactHistory::default();
+                            continue;
+                        };
+                        // The wall is body B, immovable: m_eff = m and its velocity is zero.
+                        let arm = g.point - *x;
+                        let relative = -(*v + w.cross(&arm));
+                        let f = -law.force(mass, &g, &relative, history, dt);
+                        force += f;
+                        torque += arm.cross(&f);
+                        wall_contacts += 1;
+                    }
                 }
 
                 *v += force * (dt / mass);
@@ -312,16 +317,5 @@ impl Simulation {
         let b = &self.bodies;
         let total: f64 = b.mass.iter().sum();
         b.mass.iter().zip(&b.position).map(|(m, x)| m * x.z).sum::<f64>() / total
-    }
-
-    /// The exact contact of two bodies as the narrow phase sees it, for inspection and tests.
-    pub fn body_contact(&self, i: usize, j: usize) -> Option<ContactGeometry> {
-        let b = &self.bodies;
-        let shift = self.domain.shift(self.domain.nearest_image(&b.position[i], &b.position[j]));
-        let pose = |k: usize| b.shape[k].pose(b.position[k], &b.orientation[k]);
-        let (pi, pj) = (pose(i), pose(j));
-        let a = Placed { shape: &b.shape[i], position: b.position[i], pose: pi.as_ref() };
-        let c = Placed { shape: &b.shape[j], position: b.position[j] + shift, pose: pj.as_ref() };
-        contact::between(&a, &c, &mut Vector3::zeros())
     }
 }

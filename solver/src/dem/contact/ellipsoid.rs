@@ -141,6 +141,11 @@ impl EllipsoidPose {
         self.center + p / n.dot(&p).sqrt()
     }
 
+    /// The smallest semi-axis, s_min = √(ρ s_max) from the rolling radius ρ = s_min²/s_max.
+    pub fn smallest_semi_axis(&self) -> f64 {
+        (self.rolling_radius * self.bounding_radius).sqrt()
+    }
+
     /// Radius of the smallest sphere about the centre that holds the ellipsoid (largest semi-axis).
     pub fn bounding_radius(&self) -> f64 {
         self.bounding_radius

@@ -20,37 +20,42 @@ use nalgebra::Matrix3;
 
 use self::ellipsoid::EllipsoidPose;
 use super::domain::Domain;
-use super::shape::Shape;
 
-/// A body as the narrow phase sees it: its shape at a position (the right periodic image), and
-/// for an ellipsoid its pose from the current orientation.
+/// One convex piece of a body in the world, as the narrow phase meets it: the body itself for a
+/// sphere or an ellipsoid, one component sphere of a bonded grain.
 #[derive(Clone, Copy)]
-pub struct Placed<'a> {
-    pub shape: &'a Shape,
-    pub position: Vector3<f64>,
-    pub pose: Option<&'a EllipsoidPose>,
+pub enum Piece<'a> {
+    Sphere { center: Vector3<f64>, radius: f64 },
+    /// The body's ellipsoid at the current orientation, centred at `center` (the right image).
+    Ellipsoid { pose: &'a EllipsoidPose, center: Vector3<f64> },
 }
 
-impl Placed<'_> {
-    /// The body as an ellipsoid at its position; a sphere is the ellipsoid with equal axes.
+impl Piece<'_> {
+    /// The piece as an ellipsoid; a sphere is the ellipsoid with equal axes.
     fn ellipsoid(&self) -> EllipsoidPose {
-        match (self.pose, self.shape) {
-            (Some(pose), _) => pose.with_center(self.position),
-            (None, shape) => {
-                EllipsoidPose::new(self.position, &Matrix3::identity(), Vector3::repeat(shape.bounding_radius()))
-            }
+        match *self {
+            Piece::Ellipsoid { pose, center } => pose.with_center(center),
+            Piece::Sphere { center, radius } => EllipsoidPose::new(center, &Matrix3::identity(), Vector3::repeat(radius)),
+        }
+    }
+
+    /// Smallest half-thickness, the scale against which overlaps are judged.
+    pub fn smallest_half_extent(&self) -> f64 {
+        match *self {
+            Piece::Sphere { radius, .. } => radius,
+            Piece::Ellipsoid { pose, .. } => pose.smallest_semi_axis(),
         }
     }
 }
 
-/// Contact of body A with body B. `warm` carries a direction from one step to the next: on
+/// Contact of piece A with piece B. `warm` carries a direction from one step to the next: on
 /// entry the pair's last contact normal or separating direction (zero if none), on exit the
 /// one found now (zero if none), so that both touching and merely close pairs start warm.
 #[inline(always)]
-pub fn between(a: &Placed, b: &Placed, warm: &mut Vector3<f64>) -> Option<ContactGeometry> {
-    match (a.shape, b.shape) {
-        (Shape::Sphere { radius: ra }, Shape::Sphere { radius: rb }) => {
-            sphere::sphere_sphere(&a.position, *ra, &b.position, *rb)
+pub fn between(a: &Piece, b: &Piece, warm: &mut Vector3<f64>) -> Option<ContactGeometry> {
+    match (a, b) {
+        (Piece::Sphere { center: ca, radius: ra }, Piece::Sphere { center: cb, radius: rb }) => {
+            sphere::sphere_sphere(ca, *ra, cb, *rb)
         }
         _ => curved(a, b, warm),
     }
@@ -58,7 +63,7 @@ pub fn between(a: &Placed, b: &Placed, warm: &mut Vector3<f64>) -> Option<Contac
 
 /// The non-spherical pairs, kept out of line so that the sphere path stays small.
 #[inline(never)]
-fn curved(a: &Placed, b: &Placed, warm: &mut Vector3<f64>) -> Option<ContactGeometry> {
+fn curved(a: &Piece, b: &Piece, warm: &mut Vector3<f64>) -> Option<ContactGeometry> {
     let start = (*warm != Vector3::zeros()).then_some(*warm);
     let (contact, stats) = ellipsoid::ellipsoid_ellipsoid_with_stats(&a.ellipsoid(), &b.ellipsoid(), start.as_ref());
     *warm = match (&contact, stats.separating) {
@@ -69,22 +74,22 @@ fn curved(a: &Placed, b: &Placed, warm: &mut Vector3<f64>) -> Option<ContactGeom
     contact
 }
 
-/// Contact of a body with the floor z = 0.
+/// Contact of a piece with the floor z = 0.
 #[inline]
-pub fn with_floor(a: &Placed) -> Option<ContactGeometry> {
-    match a.shape {
-        Shape::Sphere { radius } => sphere::sphere_floor(&a.position, *radius),
-        Shape::Ellipsoid { .. } => ellipsoid::ellipsoid_plane(&a.ellipsoid(), &Vector3::zeros(), &Vector3::z()),
+pub fn with_floor(p: &Piece) -> Option<ContactGeometry> {
+    match p {
+        Piece::Sphere { center, radius } => sphere::sphere_floor(center, *radius),
+        Piece::Ellipsoid { .. } => ellipsoid::ellipsoid_plane(&p.ellipsoid(), &Vector3::zeros(), &Vector3::z()),
     }
 }
 
-/// Contact of a body with the cylinder wall, if the domain has one.
+/// Contact of a piece with the cylinder wall, if the domain has one.
 #[inline]
-pub fn with_wall(a: &Placed, domain: &Domain) -> Option<ContactGeometry> {
+pub fn with_wall(p: &Piece, domain: &Domain) -> Option<ContactGeometry> {
     let Domain::Cylinder { diameter } = *domain else { return None };
     let c = diameter / 2.0;
-    match a.shape {
-        Shape::Sphere { radius } => sphere::sphere_cylinder_wall(&a.position, *radius, c, c, c),
-        Shape::Ellipsoid { .. } => ellipsoid::ellipsoid_cylinder_wall(&a.ellipsoid(), c, c, c),
+    match p {
+        Piece::Sphere { center, radius } => sphere::sphere_cylinder_wall(center, *radius, c, c, c),
+        Piece::Ellipsoid { .. } => ellipsoid::ellipsoid_cylinder_wall(&p.ellipsoid(), c, c, c),
     }
 }
