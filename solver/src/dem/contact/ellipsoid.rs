@@ -498,7 +498,7 @@ fn cap(step: Vector3<f64>) -> Vector3<f64> {
 }
 
 /// Orthonormal tangent basis at n; at −n it is (−u, v), which keeps the A/B swap exact.
-fn tangent_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+pub(super) fn tangent_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
     let m = n.abs();
     let axis = if m.x <= m.y && m.x <= m.z {
         Vector3::x()
@@ -511,7 +511,7 @@ fn tangent_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
     (u, n.cross(&u))
 }
 
-fn unit(v: &Vector3<f64>) -> Option<Vector3<f64>> {
+pub(super) fn unit(v: &Vector3<f64>) -> Option<Vector3<f64>> {
     let length = v.norm();
     (length > 0.0 && length.is_finite()).then(|| v / length)
 }
