@@ -88,6 +88,9 @@ use crate::grain::simplify::CONVEXITY_TOLERANCE;
 type V3 = Vector3<f64>;
 type V2 = Vector2<f64>;
 
+/// Tilt of GJK's three starting directions from the start direction (about 3°).
+const TILT: f64 = 0.05;
+const HALF_SQRT_3: f64 = 0.866_025_403_784_438_6;
 /// GJK iterations before the origin is taken to sit on the boundary (depth 0); a polytope pair
 /// needs far fewer (each iteration adds a support point strictly closer to the origin).
 const GJK_ITERATIONS: u32 = 64;
@@ -413,18 +416,26 @@ struct Cso<'p, A, B> {
     d: V3,
     hint_a: u32,
     hint_b: u32,
+    /// Direction of the previous query.
+    last: V3,
     queries: u32,
 }
 
 impl<'p, A: Convex, B: Convex> Cso<'p, A, B> {
     fn new(a: &'p A, b: &'p B, start: &V3) -> Self {
         let (hint_a, hint_b) = (a.cold_hint(start), b.cold_hint(&-start));
-        Self { a, b, d: b.center() - a.center(), hint_a, hint_b, queries: 0 }
+        Self { a, b, d: b.center() - a.center(), hint_a, hint_b, last: *start, queries: 0 }
     }
 
     #[inline]
     fn support(&mut self, n: &V3) -> Point {
         self.queries += 1;
+        // A direction turned by more than 90° from the previous one (GJK's far side) climbs
+        // from the start table rather than across the whole body.
+        if n.dot(&self.last) < 0.0 {
+            (self.hint_a, self.hint_b) = (self.a.cold_hint(n), self.b.cold_hint(&-n));
+        }
+        self.last = *n;
         let a = self.a.reach(n, &mut self.hint_a);
         let b = self.b.reach(&-n, &mut self.hint_b) + self.d;
         Point { w: a - b, a, b }
@@ -498,11 +509,13 @@ fn solve_polyhedra(
     // coordinates keep the boundary integrals free of cancellation.
     let middle = (end.a + end.b) * 0.5;
     let (top, bottom) = (end.normal.dot(&(end.a - middle)), end.normal.dot(&(end.b - middle)));
-    let centroid = Slab::gather(a, &frame.coordinates(&-middle), &frame, 1.0, bottom).and_then(|slab_a| {
-        let slab_b = Slab::gather(b, &frame.coordinates(&(b.center - a.center - middle)), &frame, -1.0, top)?;
+    let centroid = SLABS.with_borrow_mut(|slabs| {
+        let [slab_a, slab_b] = &mut **slabs;
+        slab_a.gather(a, &frame.coordinates(&-middle), &frame, 1.0, bottom)?;
+        slab_b.gather(b, &frame.coordinates(&(b.center - a.center - middle)), &frame, -1.0, top)?;
         let mut integrals = Integrals::default();
-        slab_a.clipped_by(&slab_b, &mut integrals)?;
-        slab_b.clipped_by(&slab_a, &mut integrals)?;
+        slab_a.clipped_by(slab_b, &mut integrals)?;
+        slab_b.clipped_by(slab_a, &mut integrals)?;
         integrals.centroid()
     });
     stats.centre_of_pressure = centroid.is_some();
@@ -630,7 +643,9 @@ fn against_plane(a: &PolyhedronPose, n: &V3, level: f64, depth: f64) -> ContactG
     // Frame coordinates from the deepest point's foot on the plane: the plane is z = 0 there,
     // and the cut face lying in it adds nothing to the integrals (x·n = 0 and n_t1 = n_t2 = 0).
     let foot = deepest - n * (n.dot(&deepest) - level);
-    let centroid = Slab::gather(a, &frame.coordinates(&-foot), &frame, 1.0, 0.0).and_then(|slab| {
+    let centroid = SLABS.with_borrow_mut(|slabs| {
+        let slab = &mut slabs[0];
+        slab.gather(a, &frame.coordinates(&-foot), &frame, 1.0, 0.0)?;
         let mut integrals = Integrals::default();
         slab.beyond(0.0, &mut integrals)?;
         integrals.centroid()
@@ -787,12 +802,26 @@ fn overlap<A: Convex, B: Convex>(
     tiny: f64,
     stats: &mut PolyhedronStats,
 ) -> Option<Simplex> {
+    // Start from three support points around `start` and the far side of K. When `start` is
+    // close to the contact normal (a persisting contact, or the centre line of a shallow one)
+    // the three usually span the face of K nearest the origin and the tetrahedron already holds
+    // the origin; otherwise GJK goes on from its nearest point. Each of the three also tests
+    // its direction for separation, so a pair that has just parted costs one support query.
+    let (t1, t2) = tangent_basis(start);
     let mut simplex = Simplex::default();
-    simplex.push(cso.support(start));
-    let mut v = simplex.p[0].w;
+    for (c, s) in [(1.0, 0.0), (-0.5, HALF_SQRT_3), (-0.5, -HALF_SQRT_3)] {
+        let u = start + (t1 * c + t2 * s) * TILT;
+        let w = cso.support(&u);
+        if u.dot(&w.w) < 0.0 {
+            return None;
+        }
+        simplex.push(w);
+    }
+    simplex.push(cso.support(&-start));
+    let mut v = simplex.reduce();
     for _ in 0..GJK_ITERATIONS {
         stats.gjk_iterations += 1;
-        if v.norm_squared() <= tiny * tiny {
+        if simplex.len == 4 || v.norm_squared() <= tiny * tiny {
             return Some(simplex);
         }
         let w = cso.support(&-v);
@@ -802,9 +831,6 @@ fn overlap<A: Convex, B: Convex>(
         }
         simplex.push(w);
         v = simplex.reduce();
-        if simplex.len == 4 {
-            return Some(simplex);
-        }
     }
     None
 }
@@ -1117,6 +1143,20 @@ struct Facet {
 struct Slab {
     facets: [Facet; CAP_TRIANGLES],
     len: usize,
+    /// Tangential bounding box of the facets, which holds the projection of the body's part
+    /// inside the slab.
+    lo: V2,
+    hi: V2,
+}
+
+thread_local! {
+    /// The two bodies' slabs, kept per thread so that queries neither allocate nor clear them.
+    static SLABS: RefCell<Box<[Slab; 2]>> = RefCell::new(Box::new(std::array::from_fn(|_| Slab {
+        facets: [Facet::default(); CAP_TRIANGLES],
+        len: 0,
+        lo: V2::zeros(),
+        hi: V2::zeros(),
+    })));
 }
 
 impl Slab {
@@ -1124,7 +1164,7 @@ impl Slab {
     /// coordinates relative to an origin from which the pose's centre lies at `shift`), found
     /// by walking the vertex graph from the vertex farthest towards `side` through the vertices
     /// beyond `level` (a connected set on a convex polyhedron). `None` if they do not fit.
-    fn gather(pose: &PolyhedronPose, shift: &V3, frame: &Frame, side: f64, level: f64) -> Option<Self> {
+    fn gather(&mut self, pose: &PolyhedronPose, shift: &V3, frame: &Frame, side: f64, level: f64) -> Option<()> {
         let shape = pose.shape;
         let axes = [frame.t1, frame.t2, frame.n].map(|a| pose.rotation.tr_mul(&a));
         let at = |v: u32| {
@@ -1132,10 +1172,13 @@ impl Slab {
             V3::new(axes[0].dot(x), axes[1].dot(x), axes[2].dot(x)) + shift
         };
         let beyond = |v: u32| side * (at(v).z - level) > 0.0;
-        let mut slab = Self { facets: [Facet::default(); CAP_TRIANGLES], len: 0 };
+        let slab = self;
+        slab.len = 0;
+        slab.lo = V2::repeat(f64::INFINITY);
+        slab.hi = V2::repeat(f64::NEG_INFINITY);
         let top = shape.climb(&(axes[2] * side), shape.start(&(axes[2] * side)));
         if !beyond(top) {
-            return Some(slab);
+            return Some(());
         }
         let mut seen = [0u32; CAP_VERTICES];
         let mut n_seen = 1;
@@ -1159,6 +1202,10 @@ impl Slab {
                     axes[2].dot(&shape.normals[t as usize]),
                 );
                 taken[slab.len] = t;
+                for corner in &p {
+                    slab.lo = slab.lo.inf(&corner.xy());
+                    slab.hi = slab.hi.sup(&corner.xy());
+                }
                 slab.facets[slab.len] = Facet { p, normal, offset: normal.dot(&p[0]) };
                 slab.len += 1;
             }
@@ -1172,13 +1219,20 @@ impl Slab {
                 }
             }
         }
-        Some(slab)
+        Some(())
     }
 
     /// Adds the parts of these facets that lie inside all of `other`'s facet planes.
     fn clipped_by(&self, other: &Slab, integrals: &mut Integrals) -> Option<()> {
+        let mut polygon = Polygon::new();
         for facet in &self.facets[..self.len] {
-            let mut polygon = Polygon::triangle(&facet.p);
+            // A facet whose projection misses the other body's part in the slab is outside it.
+            let [p, q, r] = facet.p.map(|c| c.xy());
+            let (lo, hi) = (p.inf(&q).inf(&r), p.sup(&q).sup(&r));
+            if lo.x > other.hi.x || lo.y > other.hi.y || hi.x < other.lo.x || hi.y < other.lo.y {
+                continue;
+            }
+            polygon.reset(&facet.p);
             for plane in &other.facets[..other.len] {
                 polygon.clip(|x| plane.offset - plane.normal.dot(x))?;
             }
@@ -1189,8 +1243,9 @@ impl Slab {
 
     /// Adds the parts of these facets beyond the plane z = `level`.
     fn beyond(&self, level: f64, integrals: &mut Integrals) -> Option<()> {
+        let mut polygon = Polygon::new();
         for facet in &self.facets[..self.len] {
-            let mut polygon = Polygon::triangle(&facet.p);
+            polygon.reset(&facet.p);
             polygon.clip(|x| x.z - level)?;
             integrals.add(&polygon, &facet.normal);
         }
@@ -1201,59 +1256,71 @@ impl Slab {
 /// Most corners a clipped facet may have.
 const POLYGON_CORNERS: usize = 24;
 
-/// A convex planar polygon being clipped.
+/// A convex planar polygon being clipped, in two buffers that take turns as source and
+/// destination (no copying).
 struct Polygon {
-    p: [V3; POLYGON_CORNERS],
+    p: [[V3; POLYGON_CORNERS]; 2],
+    current: usize,
     len: usize,
 }
 
 impl Polygon {
-    fn triangle(p: &[V3; 3]) -> Self {
-        let mut polygon = Self { p: [V3::zeros(); POLYGON_CORNERS], len: 3 };
-        polygon.p[..3].copy_from_slice(p);
-        polygon
+    fn new() -> Self {
+        Self { p: [[V3::zeros(); POLYGON_CORNERS]; 2], current: 0, len: 0 }
+    }
+
+    /// Starts over from a triangle (the buffers are reused from facet to facet).
+    fn reset(&mut self, p: &[V3; 3]) {
+        self.p[0][..3].copy_from_slice(p);
+        self.current = 0;
+        self.len = 3;
+    }
+
+    fn corners(&self) -> &[V3] {
+        &self.p[self.current][..self.len]
     }
 
     /// Keeps the part where the affine function `f` is non-negative (Sutherland–Hodgman);
     /// `None` if the result would not fit.
     fn clip(&mut self, f: impl Fn(&V3) -> f64) -> Option<()> {
-        if self.len == 0 {
-            return Some(());
-        }
-        let mut values = [0.0; POLYGON_CORNERS];
-        let (mut inside, mut outside) = (0, 0);
-        for (value, p) in values.iter_mut().zip(&self.p[..self.len]) {
-            *value = f(p);
-            if *value >= 0.0 {
-                inside += 1;
+        // Most planes leave the polygon whole (or remove it): decide that first, without
+        // storing the values.
+        let (mut inside, mut outside) = (false, false);
+        for p in self.corners() {
+            if f(p) >= 0.0 {
+                inside = true;
             } else {
-                outside += 1;
+                outside = true;
             }
         }
-        if outside == 0 {
+        if !outside {
             return Some(());
         }
-        if inside == 0 {
+        if !inside {
             self.len = 0;
             return Some(());
         }
-        let old = self.p;
+        let [first, second] = &mut self.p;
+        let (old, new) = if self.current == 0 { (&*first, second) } else { (&*second, first) };
         let mut len = 0;
+        let mut fi = f(&old[0]);
         for i in 0..self.len {
             let j = (i + 1) % self.len;
-            let (fi, fj) = (values[i], values[j]);
+            let fj = f(&old[j]);
             if fi >= 0.0 {
-                self.p[len] = old[i];
+                new[len] = old[i];
                 len += 1;
             }
             if (fi >= 0.0) != (fj >= 0.0) {
                 if len == POLYGON_CORNERS {
                     return None;
                 }
-                self.p[len] = old[i] + (old[j] - old[i]) * (fi / (fi - fj));
+                new[len] = old[i] + (old[j] - old[i]) * (fi / (fi - fj));
                 len += 1;
             }
+            fi = fj;
         }
+        self.current = 1 - self.current;
         self.len = len;
         Some(())
     }
@@ -1272,8 +1339,8 @@ impl Integrals {
     /// corner; on a triangle (a, b, c) of area A, ∫ x_i² = A (a_i² + b_i² + c_i² + a_i b_i +
     /// b_i c_i + c_i a_i) / 6.
     fn add(&mut self, polygon: &Polygon, normal: &V3) {
-        let p = &polygon.p;
-        for i in 1..polygon.len.saturating_sub(1) {
+        let p = polygon.corners();
+        for i in 1..p.len().saturating_sub(1) {
             let (a, b, c) = (p[0], p[i], p[i + 1]);
             let area = 0.5 * (b - a).cross(&(c - a)).dot(normal);
             self.volume += area * normal.dot(&(a + b + c)) / 9.0;
