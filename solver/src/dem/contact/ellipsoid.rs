@@ -145,6 +145,11 @@ impl EllipsoidPose {
     pub fn bounding_radius(&self) -> f64 {
         self.bounding_radius
     }
+
+    /// Q² = R diag(a², b², c²) Rᵀ, whose quadratic form gives the support function.
+    pub(super) fn shape2(&self) -> &Matrix3<f64> {
+        &self.shape2
+    }
 }
 
 /// How one ellipsoid–ellipsoid query was answered, for diagnostics and tests.

@@ -9,24 +9,25 @@
 //! h_A(n) + h_B(−n) − n·(x_B − x_A) as in the ellipsoid module).
 //!
 //! * GJK (Gilbert, Johnson & Keerthi 1988) with the signed-volume sub-algorithm (Montanari et
-//!   al. 2017) decides overlap. It stops as soon as a separating direction appears, which for a
-//!   pair that has just parted is the first support query. Overlap ends with a tetrahedron of
-//!   support points holding the origin; when the origin lies on a lower-dimensional simplex (the
-//!   symmetric cases of hand-built tests) the simplex is completed by support points off its
-//!   span, or the pair is declared touching if K has no such points (depth 0).
+//!   al. 2017) decides overlap. It starts from the tetrahedron of the support points along three
+//!   directions tilted 3° around the start direction and along its opposite: for a persisting
+//!   contact (start = last step's normal) the first three usually span the face of K nearest the
+//!   origin, so the tetrahedron already holds the origin; otherwise GJK goes on from it. A
+//!   separating direction ends it early (a pair that has just parted costs one support query).
+//!   When the origin lies on a lower-dimensional simplex (the symmetric cases of hand-built
+//!   tests) the simplex is completed by support points off its span, or the pair is touching if
+//!   K has none (depth 0, no contact).
 //! * EPA (van den Bergen 2001) grows that polytope towards ∂K: the face nearest the origin is
-//!   replaced by the support point along its normal until the support point lies on the face's
-//!   plane. For two polyhedra K is a polytope whose vertices are differences of vertices, so EPA
-//!   ends on a true face of K after finitely many steps and the depth and normal are exact to
-//!   rounding (gap tolerance 1e-12 of the pair's size).
+//!   replaced by the support point along its normal until that point lies on the face's plane.
+//!   For two polyhedra K is a polytope whose vertices are differences of vertices, so EPA ends on
+//!   a true face of K after finitely many steps: depth and normal are exact to rounding.
 //!
 //! Support queries climb the vertex adjacency graph: from the start vertex to the best
 //! neighbour until none is better. On a convex polyhedron a vertex no neighbour improves on is a
 //! global maximum (the polyhedron lies in the cone its edges span), so the climb is exact. Each
 //! query starts from the previous query's vertex of the same body (GJK and EPA ask in nearby
-//! directions), the first one from a table of the support vertices of the 26 directions of a
-//! 3 × 3 × 3 grid. A persisting contact passes last step's normal, GJK starts along it, and the
-//! pair's first support points are those of last step's contact.
+//! directions); the first one, and any turned by more than 90° from the previous, from a table
+//! of the support vertices of the 26 directions of a 3 × 3 × 3 grid.
 //!
 //! # Contact point: the overlap's centre of pressure
 //! A single point carries the contact force. EPA's witness points are arbitrary points of the
@@ -37,32 +38,40 @@
 //! for a face resting flat it is the centre of the shared area, and tilting the body moves it
 //! towards the deeper side, so the contact pushes back (a resting cube is stable; the EPA
 //! witness would make it rock between its corners). For vertex–face and edge–edge contacts it
-//! is the centroid of the small overlapping tip, at most O(δ) from the EPA witnesses. It
-//! varies continuously with the poses. Along the normal the point is placed midway between the
-//! two deepest points, as for spheres and ellipsoids.
+//! is the centroid of the small overlapping tip, within O(δ) of the EPA witnesses. It varies
+//! continuously with the poses. Along the normal the point is placed midway between the two
+//! deepest points, as for spheres and ellipsoids.
 //!
-//! The overlap of two shallowly interpenetrating convex bodies lies in the slab between A's top
-//! (height s_A along n) and B's bottom (s_B = s_A − δ); its thickness over a point p of the
-//! contact plane is a(p) − b(p), A's upper surface minus B's lower one. Only the triangles of A
-//! facing +n with a vertex above s_B and those of B facing −n with a vertex below s_A can
-//! contribute (found by walking the vertex graph from the deepest vertex); each such pair is
-//! clipped in the contact plane and the linear thickness integrated exactly. Contacts between
-//! a polyhedron and the floor or the cylinder wall use the same construction against the
-//! plane (the wall's tangent plane at the deepest point), so there the point is the exact
-//! centroid of the part of the grain beyond the plane. Spheres and ellipsoids touch a
-//! polyhedron in a point, and there the midpoint of the deepest points is used.
+//! The overlap lies in the slab between B's lowest level s_B and A's highest s_A along n. Its
+//! boundary is the part of ∂A inside B plus the part of ∂B inside A, and only the triangles of A
+//! reaching above s_B and those of B reaching below s_A can contribute; they are found by
+//! walking the vertex graph from the deepest vertex (the vertices beyond a level form a connected
+//! set on a convex polyhedron). Each such triangle of A is clipped by the planes of B's (a
+//! convex body's part in a half-space is cut out by the planes of its faces that reach into that
+//! half-space, so these planes suffice) and vice versa, and the volume and first moments follow
+//! from the clipped pieces by the divergence theorem: V = ∮ x·n dS / 3, ∫ x_i dV = ∮ x_i² n_i dS / 2.
+//! Contacts between a polyhedron and the floor or the cylinder wall use the same construction
+//! against the plane (the wall's tangent plane at the deepest point), where the cut face adds
+//! nothing. Spheres and ellipsoids touch a polyhedron in a point, and there the point is midway
+//! between the deepest points.
 //!
-//! # Accuracy
-//! * polyhedron–polyhedron, –plane: exact to rounding (tests: depth within 1e-12 of hand-built
-//!   cases and of parry3d's GJK/EPA on random hulls).
+//! # Accuracy (tests/contact_polyhedron.rs)
+//! * polyhedron–polyhedron and –plane: exact to rounding. Over 325 random hull pairs the depth
+//!   agrees with a brute-force separating-axis reference to 3e-16, the normal to 2e-15, the point
+//!   with an independently built overlap centroid to 2e-15.
 //! * polyhedron–sphere: exact (the sphere is its centre grown by its radius; the centre's
 //!   distance to the polyhedron comes from GJK, or from the nearest face plane when inside).
 //! * polyhedron–cylinder wall: the depth is the excess of the grain's farthest point from the axis
-//!   (found by a scan of the vertices, so exact); it is the minimum translational distance up to
-//!   a relative O((grain width / wall radius)²).
-//! * polyhedron–ellipsoid: K has curved patches, so EPA converges, but not in finitely many
-//!   steps; it stops when the support gap is below 1e-10 of the pair's size, which bounds the
-//!   depth error by the same amount (see the tests for the normal's accuracy).
+//!   (a scan of the vertices, so exact); it is the minimum translational distance up to a
+//!   relative O((grain width / wall radius)²).
+//! * polyhedron–ellipsoid: K has curved patches, where EPA converges only in the limit; it stops
+//!   at a support gap of 1e-10 of the pair's size (normal then within ~1e-5). The answer is then
+//!   polished by Newton on the feature of A that EPA ended on (vertex, edge or face), where the
+//!   depth function is smooth, and the polish is kept only if it stays on that feature and in
+//!   EPA's bracket: depth, normal and point exact to rounding (tests: a round ellipsoid agrees
+//!   with the exact sphere contact to 1e-15; general ones are certified local minima to 3e-16
+//!   and never deeper than parry's EPA lower bound). Overlaps deeper than the ellipsoid's
+//!   smallest radius of curvature keep EPA's answer.
 //!
 //! # Symmetry
 //! Polyhedron pairs are put in a canonical order (by centre, then orientation) before solving,
@@ -70,10 +79,11 @@
 //!
 //! # Cost
 //! Shapes precompute their adjacency once; a pose is a rotation matrix and a centre. The hot
-//! path does not allocate: EPA's polytope lives in a per-thread buffer of fixed capacity
-//! (128 vertices, far more than a shallow contact needs) and the overlap's triangles in arrays
-//! on the stack. Contacts whose overlap involves more triangles than those arrays hold fall back
-//! to the EPA witness midpoint.
+//! path does not allocate: EPA's polytope (128 vertices, far more than a shallow contact needs)
+//! and the clipped triangles (128 per body) live in per-thread buffers. A contact whose overlap
+//! involves more triangles than those hold falls back to the EPA witness midpoint
+//! ([`PolyhedronStats::centre_of_pressure`] tells). benches/contact_polyhedron.rs measures
+//! about 5 µs per persisting contact of 50-face grains and 7 µs for 300 faces.
 
 use std::cell::RefCell;
 
@@ -99,13 +109,17 @@ const EPA_VERTICES: usize = 128;
 /// Live faces of a convex polytope with V vertices number 2V − 4; the horizon being replaced adds
 /// at most V more before the old faces are recycled.
 const EPA_FACES: usize = 3 * EPA_VERTICES;
+/// Newton iterations of the polyhedron–ellipsoid polish, and the step (radians) that ends it.
+const POLISH_ITERATIONS: u32 = 16;
+const POLISH_STEP: f64 = 1e-12;
 /// Relative to the pair's size (sum of bounding radii): distances below this count as zero
 /// (the origin on a simplex, or on ∂K: touching bodies).
 const TOUCHING: f64 = 1e-13;
 /// EPA stops when the support point along the nearest face's normal lies within this (relative)
 /// distance of that face: rounding for polyhedra...
 const GAP_POLYTOPE: f64 = 1e-12;
-/// ...and the accuracy asked for curved bodies, where EPA converges only in the limit.
+/// ...and for curved bodies, where EPA converges only in the limit: close enough for the Newton
+/// polish to start in its quadratic regime.
 const GAP_SMOOTH: f64 = 1e-10;
 /// A face counts as seen from a new EPA vertex unless the vertex lies this far behind its plane,
 /// so that (nearly) coplanar faces merge instead of leaving slivers.
@@ -406,6 +420,8 @@ struct Point {
     w: V3,
     a: V3,
     b: V3,
+    /// A's vertex (for a polyhedron A), which tells the feature EPA ends on.
+    vertex: u32,
 }
 
 /// The support function of K.
@@ -438,7 +454,7 @@ impl<'p, A: Convex, B: Convex> Cso<'p, A, B> {
         self.last = *n;
         let a = self.a.reach(n, &mut self.hint_a);
         let b = self.b.reach(&-n, &mut self.hint_b) + self.d;
-        Point { w: a - b, a, b }
+        Point { w: a - b, a, b, vertex: self.hint_a }
     }
 }
 
@@ -505,7 +521,7 @@ fn solve_polyhedra(
         return (None, stats);
     };
     let frame = Frame::new(&end.normal);
-    // Frame coordinates are taken from the witness midpoint, which lies in the overlap: small
+    // Frame coordinates are taken from the witness midpoint, which lies near the overlap: small
     // coordinates keep the boundary integrals free of cancellation.
     let middle = (end.a + end.b) * 0.5;
     let (top, bottom) = (end.normal.dot(&(end.a - middle)), end.normal.dot(&(end.b - middle)));
@@ -525,8 +541,8 @@ fn solve_polyhedra(
 }
 
 /// Contact of a polyhedron (body A) with an ellipsoid (body B), or `None` when they do not
-/// overlap. Depth within 1e-10 of the pair's size (module docs); the point is the midpoint of
-/// the deepest points.
+/// overlap: EPA to a support gap of 1e-10 of the pair's size, then Newton on the polyhedron's
+/// feature (module docs); the point is the midpoint of the deepest points.
 pub fn polyhedron_ellipsoid(
     a: &PolyhedronPose,
     b: &EllipsoidPose,
@@ -534,10 +550,109 @@ pub fn polyhedron_ellipsoid(
 ) -> Option<ContactGeometry> {
     let mut stats = PolyhedronStats::default();
     let end = penetration(a, b, warm_normal, GAP_SMOOTH, &mut stats)?;
+    let reach = a.shape.bounding_radius + b.bounding_radius();
+    let (normal, depth) = polish(a, b, &end, GAP_SMOOTH * reach).unwrap_or((end.normal, end.depth));
     // EPA's witness points are barycentric mixtures of support points that may lie far apart on
     // the curved surface; the ellipsoid's own support point along −n is unique and exact.
-    let deepest = b.support(&-end.normal);
-    Some(ContactGeometry { point: deepest + end.normal * (0.5 * end.depth), normal: end.normal, depth: end.depth })
+    let deepest = b.support(&-normal);
+    Some(ContactGeometry { point: deepest + normal * (0.5 * depth), normal, depth })
+}
+
+/// Newton polish of a polyhedron–ellipsoid EPA result on the polyhedron's feature at the
+/// minimum: EPA's last face tells whether it is a vertex, an edge or a face of A, and on it the
+/// depth function f(n) = h_A(n) + h_E(−n) − n·d is smooth. A face fixes n outright; on an edge
+/// n turns about the edge (Newton on a circle); at a vertex n is free (Newton on the sphere).
+/// The result is kept only if A's support along it is still that feature and the depth lies in
+/// EPA's bracket [δ, δ + gap]; otherwise (or if the Hessian is not positive definite, which
+/// takes an overlap deeper than the ellipsoid's smallest radius of curvature) EPA's answer
+/// stands.
+fn polish(a: &PolyhedronPose, e: &EllipsoidPose, end: &Penetration, gap: f64) -> Option<(V3, f64)> {
+    let shape2 = e.shape2();
+    let d = *EllipsoidPose::center(e) - a.center;
+    let mut feature = [end.vertices[0]; 3];
+    let mut corners = 1;
+    for &v in &end.vertices[1..] {
+        if !feature[..corners].contains(&v) {
+            feature[corners] = v;
+            corners += 1;
+        }
+    }
+    let v = feature.map(|i| a.vertex(i));
+    let reach = |n: &V3| n.dot(&(shape2 * n)).sqrt();
+    let (normal, depth) = match corners {
+        1 => newton_on_sphere(&(v[0] - d), shape2, &end.normal)?,
+        2 => newton_on_circle(&(v[0] - d), &(v[1] - v[0]), shape2, &end.normal)?,
+        _ => {
+            let cross = (v[1] - v[0]).cross(&(v[2] - v[0]));
+            let n = unit(&cross)?;
+            let n = if n.dot(&end.normal) < 0.0 { -n } else { n };
+            (n, n.dot(&(v[0] - d)) + reach(&n))
+        }
+    };
+    let tolerance = TOUCHING * (a.shape.bounding_radius + e.bounding_radius());
+    let mut hint = feature[0];
+    let top = a.reach(&normal, &mut hint).dot(&normal);
+    let on_feature = top - normal.dot(&v[0]) <= tolerance;
+    let bracketed = depth >= end.depth - tolerance && depth <= end.depth + gap + tolerance;
+    (on_feature && bracketed).then_some((normal, depth))
+}
+
+/// Minimum over unit n of n·c + h(n), h(n) = √(nᵀ S n), by Riemannian Newton from `start`:
+/// the depth of a vertex (c = vertex − ellipsoid centre) in an ellipsoid. `None` if the
+/// Hessian is not positive definite or Newton does not settle.
+fn newton_on_sphere(c: &V3, shape2: &Matrix3<f64>, start: &V3) -> Option<(V3, f64)> {
+    let mut n = *start;
+    for _ in 0..POLISH_ITERATIONS {
+        let sn = shape2 * n;
+        let h = n.dot(&sn).sqrt();
+        let gradient = c + sn / h;
+        let value = n.dot(&gradient);
+        let hessian = (shape2 - sn * sn.transpose() / (h * h)) / h;
+        let (t1, t2) = tangent_basis(&n);
+        let (h1, h2) = (hessian * t1, hessian * t2);
+        let (a11, a12, a22) = (t1.dot(&h1) - value, t1.dot(&h2), t2.dot(&h2) - value);
+        let det = a11 * a22 - a12 * a12;
+        if a11 <= 0.0 || det <= 0.0 {
+            return None;
+        }
+        let (g1, g2) = (t1.dot(&gradient), t2.dot(&gradient));
+        let step = V2::new(a12 * g2 - a22 * g1, a12 * g1 - a11 * g2) / det;
+        n = (n + t1 * step.x + t2 * step.y).normalize();
+        if step.norm() <= POLISH_STEP {
+            return Some((n, n.dot(c) + n.dot(&(shape2 * n)).sqrt()));
+        }
+    }
+    None
+}
+
+/// Minimum of n·c + h(n) over the unit n perpendicular to `edge`, by Newton on that circle
+/// from the projection of `start`: the depth of an edge (c = an end − ellipsoid centre).
+fn newton_on_circle(c: &V3, edge: &V3, shape2: &Matrix3<f64>, start: &V3) -> Option<(V3, f64)> {
+    let e = unit(edge)?;
+    let u = unit(&(start - e * e.dot(start)))?;
+    let w = e.cross(&u);
+    let mut angle: f64 = 0.0;
+    for _ in 0..POLISH_ITERATIONS {
+        let (sin, cos) = angle.sin_cos();
+        let (n, t) = (u * cos + w * sin, w * cos - u * sin);
+        let sn = shape2 * n;
+        let h = n.dot(&sn).sqrt();
+        let gradient = c + sn / h;
+        let st = shape2 * t;
+        // d²/dθ² of h(n(θ)) is tᵀ∇²h t − n·∇h, and of n·c it is −n·c: together tᵀ∇²h t − f.
+        let curvature = (t.dot(&st) - (t.dot(&sn) / h).powi(2)) / h - n.dot(&gradient);
+        if curvature <= 0.0 {
+            return None;
+        }
+        let step = -t.dot(&gradient) / curvature;
+        angle += step;
+        if step.abs() <= POLISH_STEP {
+            let (sin, cos) = angle.sin_cos();
+            let n = u * cos + w * sin;
+            return Some((n, n.dot(c) + n.dot(&(shape2 * n)).sqrt()));
+        }
+    }
+    None
 }
 
 /// Contact of a polyhedron (body A) with a sphere (body B), exact.
@@ -662,6 +777,8 @@ struct Penetration {
     depth: f64,
     a: V3,
     b: V3,
+    /// A's vertices at the corners of EPA's last face.
+    vertices: [u32; 3],
 }
 
 /// GJK, then EPA: the minimum translational distance of two convex bodies, or `None` if they
@@ -1063,7 +1180,7 @@ impl Polytope {
         let [a, b, c] = v.map(|i| self.points[i as usize].w);
         let cross = (b - a).cross(&(c - a));
         let length = cross.norm();
-        if !(length > tiny * tiny) {
+        if length.is_nan() || length <= tiny * tiny {
             return None;
         }
         let normal = cross / length;
@@ -1099,6 +1216,7 @@ impl Polytope {
             depth: face.dist,
             a: p.a * lambda[0] + q.a * lambda[1] + r.a * lambda[2],
             b: p.b * lambda[0] + q.b * lambda[1] + r.b * lambda[2],
+            vertices: [p.vertex, q.vertex, r.vertex],
         }
     }
 }
