@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use super::body::{Bodies, NewBody};
 use super::contact::ellipsoid::EllipsoidPose;
-use super::contact::{self, ContactGeometry};
+use super::contact;
 use super::contact_law::{Calibration, ContactHistory, LinearSpringDashpot};
 use super::domain::Domain;
 use super::neighbours::NeighbourList;

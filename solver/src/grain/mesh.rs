@@ -168,6 +168,42 @@ impl TriMesh {
     pub fn map_vertices(&self, f: impl Fn(&Vector3<f64>) -> Vector3<f64>) -> Self {
         Self { vertices: self.vertices.iter().map(f).collect(), triangles: self.triangles.clone() }
     }
+
+    /// Whether the solid is convex: no edge folds inward by more than `tolerance` times the
+    /// bounding-box diagonal (the far vertex of each triangle's neighbour across an edge lies on or
+    /// below the triangle's plane).
+    ///
+    /// A closed, connected surface that is locally convex at every edge bounds a convex solid, so
+    /// the check is O(faces) rather than a comparison of every vertex with every face plane. The
+    /// Euler characteristic V − E + F = 2 rules out several separate components (each closed
+    /// locally convex component is a sphere and adds 2).
+    pub fn is_convex(&self, tolerance: f64) -> bool {
+        let mut used = vec![false; self.vertices.len()];
+        for &v in self.triangles.iter().flatten() {
+            used[v as usize] = true;
+        }
+        let (v, f) = (used.iter().filter(|&&u| u).count() as i64, self.triangles.len() as i64);
+        if 2 * (v + f) - 3 * f != 4 {
+            return false;
+        }
+        let slack = tolerance * self.bounding_box_diagonal();
+        let mut apex: HashMap<(u32, u32), u32> = HashMap::with_capacity(3 * self.triangles.len());
+        for tri in &self.triangles {
+            for k in 0..3 {
+                apex.insert((tri[k], tri[(k + 1) % 3]), tri[(k + 2) % 3]);
+            }
+        }
+        (0..self.triangles.len()).all(|t| {
+            let tri = self.triangles[t];
+            let [a, b, c] = self.triangle(t);
+            let normal = (b - a).cross(&(c - a)).normalize();
+            (0..3).all(|k| {
+                // The neighbour across edge (p, q) traverses it as (q, p).
+                let far = apex[&(tri[(k + 1) % 3], tri[k])];
+                normal.dot(&(self.vertices[far as usize] - a)) <= slack
+            })
+        })
+    }
 }
 
 fn check_closed_and_oriented(triangles: &[[u32; 3]]) -> Result<(), MeshDefect> {

@@ -1,7 +1,8 @@
 //! Everything about a single grain and a population of grains: form parameters and factors
-//! (§2, Table 1), meshes and their mass-equivalent ellipsoid (Appendix A), sizes from sieve
-//! curves (§3.2, Table 3), form distributions (§7.1, §7.3), generated pebble meshes and the
-//! bonded-sphere grains of the second paper (its §2.4 and Appendix).
+//! (§2, Table 1), meshes, their simplification (§5.2.1) and their mass-equivalent ellipsoid
+//! (Appendix A), sizes from sieve curves (§3.2, Table 3), form distributions (§7.1, §7.3),
+//! generated pebble meshes and the bonded-sphere grains of the second paper (its §2.4 and
+//! Appendix).
 
 pub mod bonded;
 pub mod ellipsoid;
@@ -9,6 +10,7 @@ pub mod form;
 pub mod form_distribution;
 pub mod mesh;
 pub mod pebble;
+pub mod simplify;
 pub mod size;
 pub mod unit_mesh;
 
@@ -23,5 +25,6 @@ pub use form::{
 };
 pub use form_distribution::{DistributionError, FormDistribution, FormMoments, FormSampler};
 pub use mesh::{MassProperties, MeshDefect, MeshError, TriMesh};
+pub use simplify::{Simplified, SimplifyError, simplify};
 pub use size::{SieveCurve, SizeError, SizeSampler, TABLE3, TABLE3_SIEVES, Table3Case};
 pub use unit_mesh::UnitMesh;

@@ -150,6 +150,11 @@ impl EllipsoidPose {
     pub fn bounding_radius(&self) -> f64 {
         self.bounding_radius
     }
+
+    /// Q² = R diag(a², b², c²) Rᵀ, whose quadratic form gives the support function.
+    pub(super) fn shape2(&self) -> &Matrix3<f64> {
+        &self.shape2
+    }
 }
 
 /// How one ellipsoid–ellipsoid query was answered, for diagnostics and tests.
@@ -509,7 +514,7 @@ fn cap(step: Vector3<f64>) -> Vector3<f64> {
 }
 
 /// Orthonormal tangent basis at n; at −n it is (−u, v), which keeps the A/B swap exact.
-fn tangent_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+pub(super) fn tangent_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
     let m = n.abs();
     let axis = if m.x <= m.y && m.x <= m.z {
         Vector3::x()
@@ -522,7 +527,7 @@ fn tangent_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
     (u, n.cross(&u))
 }
 
-fn unit(v: &Vector3<f64>) -> Option<Vector3<f64>> {
+pub(super) fn unit(v: &Vector3<f64>) -> Option<Vector3<f64>> {
     let length = v.norm();
     (length > 0.0 && length.is_finite()).then(|| v / length)
 }

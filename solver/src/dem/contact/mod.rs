@@ -1,6 +1,7 @@
 //! Narrow phase: the exact contact geometry of two overlapping shapes, or of a shape and a wall.
 
 pub mod ellipsoid;
+pub mod polyhedron;
 pub mod sphere;
 
 use nalgebra::Vector3;
