@@ -135,3 +135,69 @@ fn porosity_command_evaluates_a_lattice_and_rejects_bad_rows() {
     fails(&["porosity", &missing, "--width", "0.01", "--trim", "0"], &["missing.csv", "'r'"]);
     fails(&["porosity", &path, "--width", "-1", "--trim", "0"], &["--width"]);
 }
+
+/// An OBJ of a 10 mm box with one face pushed in: closed and valid, but not convex.
+fn dented_box() -> String {
+    let mut obj = String::new();
+    for k in 0..8 {
+        let s = |bit: u32| if k & (1 << bit) != 0 { 0.005 } else { -0.005 };
+        obj.push_str(&format!("v {} {} {}\n", s(0), s(1), s(2)));
+    }
+    obj.push_str("v 0 0 0.002\n"); // the dent, below the top face's centre
+    obj.push_str("f 1 3 4 2\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n");
+    obj.push_str("f 5 6 9\nf 6 8 9\nf 8 7 9\nf 7 5 9\n");
+    obj
+}
+
+#[test]
+fn mesh_grains_from_a_folder_use_the_convex_hull_of_a_dented_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let meshes = dir.path().join("grains");
+    std::fs::create_dir(&meshes).unwrap();
+    write(&meshes, "dented.obj", &dented_box());
+    let job = write(
+        dir.path(),
+        "mesh.yaml",
+        "domain: {kind: periodic, width: 0.04, height: 0.1}\ngrains:\n  shape: mesh\n  meshes: grains\n  faces: 50\n  size: {sieves: [0.0056, 0.008], fractions: [1.0]}\n  mass: 0.03\nprocess:\n  generation: {spacing: 0.012}\n  shaking: {duration: 0.02}\nevaluation: {trim: 0.0}\n",
+    );
+    let out = dir.path().join("out");
+    let run = sedpack(&["pack", &job, "--out", out.to_str().unwrap(), "--json"]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    assert!(stderr.contains("dented.obj") && stderr.contains("convex hull"), "warned: {stderr}");
+    let particles = std::fs::read_to_string(out.join("particles.csv")).unwrap();
+    assert!(particles.lines().skip(1).all(|l| l.split(',').nth(1) == Some("mesh")));
+    // The hull of the dented box is the box: its own form, rescaled to each grain's size D, has
+    // L = I = S (a cube), so the stored statistics give FL = EL = 1.
+    let result: Value = serde_json::from_slice(&run.stdout).unwrap();
+    assert!((result["statistics"]["mean_FL"].as_f64().unwrap() - 1.0).abs() < 1e-9);
+}
+
+#[test]
+fn bad_mesh_keys_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("empty")).unwrap();
+    let empty = write(dir.path(), "empty.yaml", "grains:\n  shape: mesh\n  meshes: empty\n");
+    fails(&["pack", &empty], &["empty.yaml:3", "grains.meshes", "no STL or OBJ"]);
+    let faces = write(dir.path(), "faces.yaml", "grains:\n  shape: mesh\n  faces: 2\n");
+    fails(&["pack", &faces], &["faces.yaml:3", "grains.faces", "at least 4"]);
+    let own = write(dir.path(), "own.yaml", "grains:\n  shape: ellipsoid\n  form: mesh\n");
+    fails(&["pack", &own], &["own.yaml:3", "grains.form", "grains.shape: mesh"]);
+    let stray = write(dir.path(), "stray.yaml", "grains:\n  shape: sphere\n  meshes: builtin:rhine\n");
+    fails(&["pack", &stray], &["grains.meshes", "mesh only"]);
+}
+
+#[test]
+fn forms_simplifies_a_mesh_and_reports_the_volume_change() {
+    let rhine = format!("{}/../solver/meshes/rhine_scan_0.obj", env!("CARGO_MANIFEST_DIR"));
+    let out = sedpack(&["forms", "--mesh", &rhine, "--faces", "50", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["triangles"].as_u64().unwrap() <= 50);
+    // Table 4: simplification to 50 faces removes a few percent of the volume.
+    let change = v["volume_change"].as_f64().unwrap();
+    assert!(change < 0.0 && change > -0.06, "volume change {change}");
+    let full = sedpack(&["forms", "--mesh", &rhine, "--json"]);
+    let full: Value = serde_json::from_slice(&full.stdout).unwrap();
+    assert!((v["volume"].as_f64().unwrap() / full["volume"].as_f64().unwrap() - 1.0 - change).abs() < 1e-12);
+}

@@ -184,6 +184,10 @@ pub struct FormsArgs {
     /// A closed triangle mesh (STL or OBJ); its form is that of its mass-equivalent ellipsoid.
     #[arg(long)]
     pub mesh: Option<PathBuf>,
+    /// Simplify the mesh to at most this many faces first (quadric edge collapse, §5.2.1) and
+    /// report the relative volume change.
+    #[arg(long, requires = "mesh")]
+    pub faces: Option<usize>,
     /// The bonded-sphere grain of Sun & Xiao built for axes L ≥ I ≥ S: its Zingg class, component
     /// spheres and mass properties beside those of the ellipsoid with the same axes.
     #[arg(long, num_args = 3, value_names = ["L", "I", "S"], allow_negative_numbers = true)]

@@ -4,6 +4,7 @@
 pub mod campaign;
 pub mod cli;
 pub mod commands;
+pub mod meshes;
 pub mod output;
 pub mod runner;
 pub mod spec;

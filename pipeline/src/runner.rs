@@ -15,6 +15,7 @@ use store::{GrainStatistic, JobResult, ProfilePoint, Store};
 use tokio::sync::mpsc;
 use tracing::{info, warn};
 
+use crate::meshes;
 use crate::spec::JobSpec;
 
 /// A running job proves it is alive this often.
@@ -176,9 +177,9 @@ impl Worker {
             let label: Vec<String> = claimed.parameters.iter().map(|(k, v)| format!("{k}={v}")).collect();
             let label = format!("{} ({})", &claimed.id[..8], label.join(", "));
             info!(job = %claimed.id, worker = %self.id, attempt = claimed.attempts, "started");
-            let outcome = match serde_json::from_value::<JobSpec>(claimed.spec.clone()) {
+            let outcome = match read_spec(&claimed.spec) {
                 Ok(spec) => self.execute(&claimed.id, spec, &label, pool.clone()).await?,
-                Err(e) => Outcome::Failed(format!("the stored spec cannot be read by this version of sedpack: {e}")),
+                Err(e) => Outcome::Failed(format!("{e:#}")),
             };
             match outcome {
                 Outcome::Done(result) => {
@@ -268,7 +269,13 @@ fn simulate(
     interval: Duration,
 ) -> Outcome {
     let restored = checkpoint.and_then(|data| match postcard::from_bytes::<Packing>(&data) {
-        Ok(packing) if packing.spec() == &spec.packing => Some(packing),
+        Ok(mut packing) if packing.spec() == &spec.packing => {
+            // A checkpoint keeps only the digest of the meshes; the job brought them back.
+            match &spec.packing.grains.meshes {
+                Some(library) => packing.attach_meshes(library).ok().map(|_| packing),
+                None => Some(packing),
+            }
+        }
         _ => {
             warn!("ignoring a checkpoint that does not match the job");
             None
@@ -309,6 +316,16 @@ fn simulate(
         Ok(result) => Outcome::Done(Box::new(result)),
         Err(e) => Outcome::Failed(e.to_string()),
     }
+}
+
+/// A stored job's spec, with its meshes loaded again and checked against their digest.
+fn read_spec(stored: &serde_json::Value) -> anyhow::Result<JobSpec> {
+    let mut spec: JobSpec =
+        serde_json::from_value(stored.clone()).context("the stored spec cannot be read by this version of sedpack")?;
+    if let Some(library) = &mut spec.packing.grains.meshes {
+        meshes::reload(library)?;
+    }
+    Ok(spec)
 }
 
 fn store_rows(result: &PackingResult) -> (JobResult, Vec<GrainStatistic>) {

@@ -12,6 +12,8 @@ use solver::dem::{Calibration, Domain, Shaking};
 use solver::grain::{FormDistribution, SieveCurve, Table3Case};
 use solver::packing::{FormSpec, GrainSpec, Material, PackingSpec, Process, ShapeKind};
 
+use crate::meshes;
+
 /// The Rhine form distribution of Table 2, the default for non-spherical grains.
 pub const RHINE_FORMS: FormDistribution =
     FormDistribution { mu_fl: 0.647, sigma_fl: 0.175, mu_el: 0.682, sigma_el: 0.139 };
@@ -50,6 +52,8 @@ pub struct DomainFile {
 pub enum ShapeFile {
     Sphere,
     Ellipsoid,
+    BondedSpheres,
+    Mesh,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -59,6 +63,8 @@ pub struct GrainsFile {
     pub size: Option<SizeFile>,
     pub mass: Option<f64>,
     pub form: Option<FormFile>,
+    pub meshes: Option<String>,
+    pub faces: Option<usize>,
 }
 
 /// A Table 3 case by name, or a sieve curve.
@@ -68,11 +74,12 @@ pub enum SizeFile {
     Curve { sieves: Vec<f64>, fractions: Vec<f64> },
 }
 
-/// One form for all grains, or a §7.1 distribution.
+/// One form for all grains, a §7.1 distribution, or each mesh's own form (`mesh`).
 #[derive(Debug)]
 pub enum FormFile {
     Single { fl: f64, el: f64 },
     Distribution { mu_fl: f64, sigma_fl: f64, mu_el: f64, sigma_el: f64 },
+    Own,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -313,10 +320,34 @@ pub fn resolve(file: JobFile, source: &Source) -> anyhow::Result<JobSpec> {
     let shape = match g.shape.unwrap_or(ShapeFile::Ellipsoid) {
         ShapeFile::Sphere => ShapeKind::Sphere,
         ShapeFile::Ellipsoid => ShapeKind::Ellipsoid,
+        ShapeFile::BondedSpheres => ShapeKind::BondedSpheres,
+        ShapeFile::Mesh => ShapeKind::Mesh,
+    };
+    let meshes = match (shape, g.meshes, g.faces) {
+        (ShapeKind::Mesh, library, faces) => {
+            // n_F ≤ 300, the simplification the paper settled on (§5.2.1, Table 4).
+            let faces = faces.unwrap_or(300);
+            if faces < 4 {
+                return Err(source
+                    .error("grains.faces", format!("{faces} is out of range: a closed mesh has at least 4 faces")));
+            }
+            let base = source.path.parent().unwrap_or(Path::new("."));
+            let library = meshes::load(library.as_deref().unwrap_or(meshes::RHINE), faces, base)
+                .map_err(|e| source.error("grains.meshes", format!("{e:#}")))?;
+            Some(library)
+        }
+        (_, Some(_), _) => return Err(source.error("grains.meshes", "applies to grains.shape: mesh only")),
+        (_, _, Some(_)) => return Err(source.error("grains.faces", "applies to grains.shape: mesh only")),
+        _ => None,
     };
     let form = match (shape, g.form) {
         (ShapeKind::Sphere, Some(_)) => return Err(source.error("grains.form", "has no meaning for spheres")),
         (ShapeKind::Sphere, None) => FormSpec::Single { fl: 1.0, el: 1.0 },
+        // Meshes keep their own forms unless told otherwise, the paper's default (§3.2).
+        (ShapeKind::Mesh, None | Some(FormFile::Own)) => FormSpec::Own,
+        (_, Some(FormFile::Own)) => {
+            return Err(source.error("grains.form", "`mesh` (each mesh's own form) needs grains.shape: mesh"));
+        }
         (_, None) => FormSpec::Distribution(RHINE_FORMS),
         (_, Some(FormFile::Single { fl, el })) => {
             check(source, "grains.form.fl", fl, fl > 0.0 && fl <= 1.0, "a flatness in (0, 1]")?;
@@ -429,7 +460,7 @@ pub fn resolve(file: JobFile, source: &Source) -> anyhow::Result<JobSpec> {
         packing: PackingSpec {
             domain,
             height,
-            grains: GrainSpec { shape, size, mass, form },
+            grains: GrainSpec { shape, size, mass, form, meshes },
             material,
             time_step,
             calibration,
@@ -515,22 +546,37 @@ impl<'de> Deserialize<'de> for FormFile {
             mu_el: Option<f64>,
             sigma_el: Option<f64>,
         }
-        let f = Form::deserialize(deserializer)?;
-        match f {
-            Form { fl: Some(fl), el: Some(el), mu_fl: None, sigma_fl: None, mu_el: None, sigma_el: None } => {
-                Ok(FormFile::Single { fl, el })
+        struct FormVisitor;
+        impl<'de> Visitor<'de> for FormVisitor {
+            type Value = FormFile;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("{fl, el}, {mu_fl, sigma_fl, mu_el, sigma_el} or `mesh`")
             }
-            Form {
-                fl: None,
-                el: None,
-                mu_fl: Some(mu_fl),
-                sigma_fl: Some(sigma_fl),
-                mu_el: Some(mu_el),
-                sigma_el: Some(sigma_el),
-            } => Ok(FormFile::Distribution { mu_fl, sigma_fl, mu_el, sigma_el }),
-            _ => Err(de::Error::custom(
-                "expected either {fl, el} (one form) or {mu_fl, sigma_fl, mu_el, sigma_el} (a distribution, §7.1)",
-            )),
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<FormFile, E> {
+                if v == "mesh" { Ok(FormFile::Own) } else { Err(E::invalid_value(de::Unexpected::Str(v), &self)) }
+            }
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<FormFile, A::Error> {
+                form(Form::deserialize(de::value::MapAccessDeserializer::new(map))?)
+            }
         }
+        fn form<E: de::Error>(f: Form) -> Result<FormFile, E> {
+            match f {
+                Form { fl: Some(fl), el: Some(el), mu_fl: None, sigma_fl: None, mu_el: None, sigma_el: None } => {
+                    Ok(FormFile::Single { fl, el })
+                }
+                Form {
+                    fl: None,
+                    el: None,
+                    mu_fl: Some(mu_fl),
+                    sigma_fl: Some(sigma_fl),
+                    mu_el: Some(mu_el),
+                    sigma_el: Some(sigma_el),
+                } => Ok(FormFile::Distribution { mu_fl, sigma_fl, mu_el, sigma_el }),
+                _ => Err(de::Error::custom(
+                    "expected either {fl, el} (one form), {mu_fl, sigma_fl, mu_el, sigma_el} (a distribution, §7.1) or `mesh` (each mesh's own form)",
+                )),
+            }
+        }
+        deserializer.deserialize_any(FormVisitor)
     }
 }

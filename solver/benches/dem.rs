@@ -12,7 +12,7 @@ use nalgebra::{UnitQuaternion, Vector3};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use solver::dem::{Calibration, Domain, NewBody, Settings, Shaking, Shape, Simulation};
-use solver::grain::{FormDistribution, SieveCurve};
+use solver::grain::{FormDistribution, MeshLibrary, SieveCurve, UnitMesh, rhine_meshes};
 use solver::packing::{FormSpec, GrainSpec, Material, Packing, PackingSpec, Phase, Process, ShapeKind};
 
 struct Bed {
@@ -56,26 +56,28 @@ fn store(name: &str, sim: &Simulation) {
     std::fs::write(&path, serde_json::to_string(sim).unwrap()).unwrap();
 }
 
-/// A bed of ellipsoids of the Rhine form distribution (Table 2) in the 5.6–8 mm class, made by
-/// the packing protocol itself (§4.3) with a short shaking, in a periodic square of `width`.
-fn ellipsoid_bed(name: &str, width: f64, mass: f64) -> Simulation {
+/// A bed made by the packing protocol itself (§4.3) with a short shaking, in a periodic square
+/// of `width`: grains of the 5.6–8 mm class, ellipsoids and bonded spheres of the Rhine form
+/// distribution (Table 2), polyhedra of the two Rhine scans with their own forms.
+fn protocol_bed(name: &str, shape: ShapeKind, width: f64, mass: f64) -> Simulation {
     if let Some(sim) = cached(name) {
         return sim;
     }
+    let rhine = FormDistribution { mu_fl: 0.647, sigma_fl: 0.175, mu_el: 0.682, sigma_el: 0.139 };
+    let (form, meshes) = match shape {
+        ShapeKind::Mesh => {
+            let meshes = rhine_meshes().iter().map(|(_, m)| UnitMesh::new(m).unwrap()).collect();
+            (
+                FormSpec::Own,
+                Some(MeshLibrary { source: "builtin:rhine".into(), faces: 300, digest: String::new(), meshes }),
+            )
+        }
+        _ => (FormSpec::Distribution(rhine), None),
+    };
     let spec = PackingSpec {
         domain: Domain::Periodic { width },
         height: 0.4,
-        grains: GrainSpec {
-            shape: ShapeKind::Ellipsoid,
-            size: SieveCurve::new(vec![5.6e-3, 8e-3], vec![1.0]).unwrap(),
-            mass,
-            form: FormSpec::Distribution(FormDistribution {
-                mu_fl: 0.647,
-                sigma_fl: 0.175,
-                mu_el: 0.682,
-                sigma_el: 0.139,
-            }),
-        },
+        grains: GrainSpec { shape, size: SieveCurve::new(vec![5.6e-3, 8e-3], vec![1.0]).unwrap(), mass, form, meshes },
         material: Material::default(),
         time_step: 5e-6,
         calibration: Calibration::Discrete { time_step: 5e-6 },
@@ -148,12 +150,18 @@ fn particle_steps(c: &mut Criterion) {
     ];
     let mut group = c.benchmark_group("settled_bed");
     group.sample_size(10);
-    // About 2,000 and 8,000 ellipsoids (mean grain mass 0.66 g).
-    let ellipsoids = [("ellipsoids-2000", 0.06, 1.32), ("ellipsoids-8000", 0.12, 5.3)];
+    // About 2,000 and 8,000 ellipsoids (mean grain mass 0.66 g) and 2,000 grains of the other
+    // shapes (bonded grains are lighter: 0.45 g).
+    let protocol = [
+        ("ellipsoids-2000", ShapeKind::Ellipsoid, 0.06, 1.32),
+        ("ellipsoids-8000", ShapeKind::Ellipsoid, 0.12, 5.3),
+        ("polyhedra-2000", ShapeKind::Mesh, 0.06, 1.32),
+        ("bonded-2000", ShapeKind::BondedSpheres, 0.06, 0.9),
+    ];
     let all = beds
         .iter()
         .map(|bed| (bed.name, settled(bed)))
-        .chain(ellipsoids.iter().map(|&(n, w, m)| (n, ellipsoid_bed(n, w, m))));
+        .chain(protocol.iter().map(|&(n, shape, w, m)| (n, protocol_bed(n, shape, w, m))));
     for (name, base) in all {
         group.throughput(Throughput::Elements(base.bodies.len() as u64));
         for threads in [1, 2] {

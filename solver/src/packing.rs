@@ -12,9 +12,11 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::SolverError;
+use crate::dem::shape::Polyhedron;
 use crate::dem::{Calibration, Domain, NewBody, Settings, Shaking, Shape, Simulation};
 use crate::grain::{
-    FormDistribution, FormParameters, FormStatistic, SieveCurve, SizeSampler, bonded_grain, form_statistics,
+    FormDistribution, FormParameters, FormStatistic, MeshLibrary, SieveCurve, SizeSampler, bonded_grain,
+    form_statistics,
 };
 use crate::porosity::{self, Porosity, PorosityError, PorositySettings};
 
@@ -51,6 +53,8 @@ pub enum ShapeKind {
     Ellipsoid,
     /// The bonded-sphere grain of Sun & Xiao (§2.4) built for each grain's L, I, S.
     BondedSpheres,
+    /// A convex polyhedron: a mesh of the library rescaled to the grain's L, I, S (Fig. 5).
+    Mesh,
 }
 
 /// How each grain's form is chosen.
@@ -60,6 +64,8 @@ pub enum FormSpec {
     Single { fl: f64, el: f64 },
     /// FL and EL drawn per grain (§7.1).
     Distribution(FormDistribution),
+    /// Each mesh keeps its own form, scaled to the grain's size (§5.1).
+    Own,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -69,6 +75,8 @@ pub struct GrainSpec {
     /// Total mass generated, m_tot (kg).
     pub mass: f64,
     pub form: FormSpec,
+    /// The meshes of `ShapeKind::Mesh`, drawn from uniformly (§3.2).
+    pub meshes: Option<MeshLibrary>,
 }
 
 /// Process parameters of §4.3 (generation, shaking, damping, convergence).
@@ -121,6 +129,8 @@ pub enum PackingError {
     NotConverged(f64),
     #[error("the packing has not converged yet")]
     Unfinished,
+    #[error("grains.meshes: {0}")]
+    Meshes(String),
 }
 
 /// The stage of the protocol.
@@ -218,6 +228,9 @@ impl Packing {
         if grid.is_empty() {
             return Err(PackingError::NoGridPositions { spacing: spec.process.spacing });
         }
+        if spec.grains.shape == ShapeKind::Mesh && spec.grains.meshes.as_ref().is_none_or(|m| m.meshes.is_empty()) {
+            return Err(PackingError::Meshes("a mesh packing needs at least one mesh".into()));
+        }
         Ok(Self {
             rng: ChaCha8Rng::seed_from_u64(spec.seed),
             simulation,
@@ -236,6 +249,18 @@ impl Packing {
 
     pub fn spec(&self) -> &PackingSpec {
         &self.spec
+    }
+
+    /// Gives a packing restored from a checkpoint its meshes back (a checkpoint keeps only their
+    /// digest); they must be the ones it was started with.
+    pub fn attach_meshes(&mut self, library: &MeshLibrary) -> Result<(), PackingError> {
+        match &mut self.spec.grains.meshes {
+            Some(own) if own == library => {
+                own.meshes.clone_from(&library.meshes);
+                Ok(())
+            }
+            _ => Err(PackingError::Meshes(format!("{}: not the meshes this packing was started with", library.source))),
+        }
     }
 
     pub fn phase(&self) -> Phase {
@@ -269,7 +294,7 @@ impl Packing {
                 Phase::Generation
                     if self.simulation.steps.is_multiple_of(GENERATION_CHECK_STEPS) && self.last_set_left() =>
                 {
-                    self.generate_set();
+                    self.generate_set()?;
                     if self.created_mass >= self.spec.grains.mass {
                         self.shaking_until = self.simulation.time + p.shaking_duration;
                         self.phase = Phase::Shaking;
@@ -310,13 +335,14 @@ impl Packing {
 
     /// Fills the generation grid with new grains until the target mass is reached. A position
     /// where the new grain would overlap one created before is left empty for this set.
-    fn generate_set(&mut self) {
+    fn generate_set(&mut self) -> Result<(), PackingError> {
         let spec = &self.spec;
         let sizes: SizeSampler = spec.grains.size.sampler();
         let forms = match spec.grains.form {
             FormSpec::Distribution(d) => Some(d.sampler()),
-            FormSpec::Single { .. } => None,
+            FormSpec::Single { .. } | FormSpec::Own => None,
         };
+        let meshes = spec.grains.meshes.as_ref().map_or(&[][..], |m| &m.meshes[..]);
         let u = spec.process.velocity;
         self.set_start = self.simulation.bodies.len();
         for &position in &self.grid {
@@ -324,18 +350,27 @@ impl Packing {
                 break;
             }
             let (class, size) = sizes.sample(&mut self.rng);
+            let mesh = (spec.grains.shape == ShapeKind::Mesh).then(|| &meshes[self.rng.random_range(0..meshes.len())]);
             let form = match (spec.grains.shape, spec.grains.form, &forms) {
                 (ShapeKind::Sphere, ..) => FormParameters { l: size, i: size, s: size },
                 (_, FormSpec::Single { fl, el }, _) => FormParameters::from_flatness_elongation(fl, el, size),
+                (_, FormSpec::Own, _) => match mesh {
+                    Some(unit) => unit.original_form().scaled_to_size(size),
+                    None => return Err(PackingError::Meshes("a mesh's own form needs grains.shape: mesh".into())),
+                },
                 (_, _, Some(sampler)) => sampler.sample(size, &mut self.rng),
                 (_, FormSpec::Distribution(_), None) => unreachable!("a distribution always has a sampler"),
             };
-            let shape = match spec.grains.shape {
-                ShapeKind::Sphere => Shape::Sphere { radius: size / 2.0 },
-                ShapeKind::Ellipsoid => Shape::Ellipsoid { semi_axes: Vector3::new(form.l, form.i, form.s) / 2.0 },
-                ShapeKind::BondedSpheres => {
+            let shape = match (spec.grains.shape, mesh) {
+                (ShapeKind::Sphere, _) => Shape::Sphere { radius: size / 2.0 },
+                (ShapeKind::Ellipsoid, _) => Shape::Ellipsoid { semi_axes: Vector3::new(form.l, form.i, form.s) / 2.0 },
+                (ShapeKind::BondedSpheres, _) => {
                     Shape::from(&bonded_grain(&form).expect("sampled forms satisfy L ≥ I ≥ S > 0"))
                 }
+                (ShapeKind::Mesh, Some(unit)) => Shape::Polyhedron(Box::new(
+                    Polyhedron::from_mesh(&unit.rescaled(&form)).map_err(|e| PackingError::Meshes(e.to_string()))?,
+                )),
+                (ShapeKind::Mesh, None) => unreachable!("a mesh was drawn for a mesh packing"),
             };
             let orientation = random_rotation(&mut self.rng);
             let mut spin = || self.rng.random_range(-0.1..0.1) * u;
@@ -353,6 +388,7 @@ impl Packing {
             self.created_mass += spec.material.density * volume;
             self.grains.push(GrainRecord { class, size, form });
         }
+        Ok(())
     }
 
     fn overlaps_existing(&self, body: &NewBody) -> bool {

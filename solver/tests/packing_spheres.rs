@@ -15,6 +15,7 @@ fn spec(friction: f64, shaking_duration: f64, seed: u64) -> PackingSpec {
             size: SieveCurve::new(vec![5.6e-3, 8e-3], vec![1.0]).unwrap(),
             mass: 0.14,
             form: FormSpec::Single { fl: 1.0, el: 1.0 },
+            meshes: None,
         },
         material: Material { friction, ..Material::default() },
         time_step: 5e-6,
@@ -37,7 +38,7 @@ fn spec(friction: f64, shaking_duration: f64, seed: u64) -> PackingSpec {
 }
 
 fn porosity(friction: f64) -> f64 {
-    let mut packing = Packing::new(spec(friction, 0.5, 1)).unwrap();
+    let mut packing = Packing::new(spec(friction, 0.3, 1)).unwrap();
     while packing.advance(50_000).unwrap() != Phase::Converged {}
     let result = packing.result().unwrap();
     // The trim defaults to the largest sieve, 8 mm, at both ends (§6.1).

@@ -2,6 +2,7 @@
 
 use anyhow::Context;
 use serde_json::{Map, Value, json};
+use solver::grain::simplify::simplify;
 use solver::grain::{EquivalentEllipsoid, FormDistribution, FormParameters, TriMesh, bonded_grain, ellipsoid_mass};
 
 use crate::cli::{DistributionArgs, FormsArgs};
@@ -12,11 +13,20 @@ pub fn run(args: &FormsArgs) -> anyhow::Result<()> {
         let form = FormParameters::new(lis[0], lis[1], lis[2]).context("--lis")?;
         (grain_record(&form, form.ellipsoid_volume()), "grain (ellipsoid with full axes L, I, S)".to_string())
     } else if let Some(path) = &args.mesh {
-        let mesh = TriMesh::from_file(path)?;
+        let mut mesh = TriMesh::from_file(path)?;
+        let mut volume_change = None;
+        if let Some(faces) = args.faces {
+            let simplified = simplify(&mesh, faces).with_context(|| format!("{}: --faces {faces}", path.display()))?;
+            volume_change = Some(simplified.volume_change);
+            mesh = simplified.mesh;
+        }
         let props = mesh.mass_properties();
         let form = EquivalentEllipsoid::of(&props).form().with_context(|| format!("{}", path.display()))?;
         let mut record = grain_record(&form, props.volume);
         record.insert("triangles".into(), json!(mesh.triangles().len()));
+        if let Some(change) = volume_change {
+            record.insert("volume_change".into(), json!(change));
+        }
         record.insert(
             "center_of_mass".into(),
             json!([props.center_of_mass.x, props.center_of_mass.y, props.center_of_mass.z]),
@@ -36,6 +46,7 @@ pub fn run(args: &FormsArgs) -> anyhow::Result<()> {
     let mut table = Table::default();
     for (key, value) in &record {
         match value {
+            Value::Number(n) if n.is_u64() => table.row(key, n.to_string()),
             Value::Number(n) => table.row(key, number(n.as_f64().unwrap_or(f64::NAN))),
             Value::Null => table.row(key, "undefined"),
             Value::String(text) => table.row(key, text.clone()),

@@ -146,9 +146,15 @@ fn write_outputs(out: &Path, job: &JobSpec, packing: &Packing, result: &PackingR
     writeln!(file, "id,shape,x,y,z,qw,qx,qy,qz,a,b,c,D,volume")?;
     for k in 0..bodies.len() {
         let (x, q) = (bodies.position[k], bodies.orientation[k]);
-        let (kind, axes) = match &bodies.shape[k] {
+        // Semi-axes: the shape's own for spheres and ellipsoids, those of the mass-equivalent
+        // ellipsoid (L/2, I/2, S/2) for bonded grains and polyhedra.
+        let shape = &bodies.shape[k];
+        let form = shape.form();
+        let (kind, axes) = match shape {
             solver::dem::Shape::Sphere { radius } => ("sphere", [*radius; 3]),
             solver::dem::Shape::Ellipsoid { semi_axes } => ("ellipsoid", [semi_axes.x, semi_axes.y, semi_axes.z]),
+            solver::dem::Shape::Bonded(_) => ("bonded-spheres", [form.l / 2.0, form.i / 2.0, form.s / 2.0]),
+            solver::dem::Shape::Polyhedron(_) => ("mesh", [form.l / 2.0, form.i / 2.0, form.s / 2.0]),
         };
         writeln!(
             file,

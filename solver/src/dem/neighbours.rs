@@ -228,7 +228,8 @@ impl NeighbourList {
                             for image in domain.images_within(&xi, &bodies.position[j], reach) {
                                 let xj = bodies.position[j] + domain.shift(image);
                                 if (xj - xi).norm_squared() < reach * reach {
-                                    let body_pair = Pair { i: i as u32, j: j as u32, image, pieces: [0, 0], effective_mass };
+                                    let body_pair =
+                                        Pair { i: i as u32, j: j as u32, image, pieces: [0, 0], effective_mass };
                                     push_piece_pairs(&mut self.pairs, body_pair, bodies, xj, self.skin);
                                 }
                             }

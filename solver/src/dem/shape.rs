@@ -7,7 +7,8 @@ use serde::{Deserialize, Serialize};
 
 use super::contact::Piece;
 use super::contact::ellipsoid::EllipsoidPose;
-use crate::grain::{BondedGrain, ComponentSphere, FormParameters};
+use super::contact::polyhedron::{ConvexPolyhedron, PolyhedronError, PolyhedronPose};
+use crate::grain::{BondedGrain, ComponentSphere, EquivalentEllipsoid, FormParameters, TriMesh};
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum Shape {
@@ -21,6 +22,70 @@ pub enum Shape {
     /// Rigidly bonded, non-overlapping spheres (Sun & Xiao §2.4) in the principal-axes frame with
     /// the centre of mass at the origin; contacts are those of the component spheres.
     Bonded(Box<Bonded>),
+    /// A convex polyhedron (a grain mesh, §3.1) in its principal-axes frame, centre of mass at
+    /// the origin.
+    Polyhedron(Box<Polyhedron>),
+}
+
+/// A convex polyhedron grain with its mass properties, precomputed once.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(try_from = "PolyhedronRecord", into = "PolyhedronRecord")]
+pub struct Polyhedron {
+    pub hull: ConvexPolyhedron,
+    pub volume: f64,
+    /// Principal moments per unit density along the body axes.
+    pub inertia: Vector3<f64>,
+    /// L, I, S of its mass-equivalent ellipsoid (Appendix A).
+    pub form: FormParameters,
+}
+
+impl Polyhedron {
+    /// A grain from a closed convex mesh given in its principal-axes frame (as
+    /// [`crate::grain::UnitMesh::rescaled`] gives it): mass properties from the mesh itself.
+    pub fn from_mesh(mesh: &TriMesh) -> Result<Self, PolyhedronError> {
+        let props = mesh.mass_properties();
+        let form = EquivalentEllipsoid::of(&props).form().map_err(|_| PolyhedronError::NotConvex)?;
+        Ok(Self { hull: ConvexPolyhedron::new(mesh)?, volume: props.volume, inertia: props.inertia.diagonal(), form })
+    }
+}
+
+impl PartialEq for Polyhedron {
+    fn eq(&self, other: &Self) -> bool {
+        self.hull.vertices() == other.hull.vertices() && self.hull.triangles() == other.hull.triangles()
+    }
+}
+
+/// What a checkpoint keeps of a polyhedron: the mesh and its mass properties; the narrow
+/// phase's tables are rebuilt from the mesh.
+#[derive(Serialize, Deserialize)]
+struct PolyhedronRecord {
+    vertices: Vec<Vector3<f64>>,
+    triangles: Vec<[u32; 3]>,
+    volume: f64,
+    inertia: Vector3<f64>,
+    form: FormParameters,
+}
+
+impl From<Polyhedron> for PolyhedronRecord {
+    fn from(p: Polyhedron) -> Self {
+        Self {
+            vertices: p.hull.vertices().to_vec(),
+            triangles: p.hull.triangles().to_vec(),
+            volume: p.volume,
+            inertia: p.inertia,
+            form: p.form,
+        }
+    }
+}
+
+impl TryFrom<PolyhedronRecord> for Polyhedron {
+    type Error = String;
+
+    fn try_from(r: PolyhedronRecord) -> Result<Self, String> {
+        let mesh = TriMesh::new(r.vertices, r.triangles).map_err(|e| format!("stored polyhedron: mesh {e}"))?;
+        let hull = ConvexPolyhedron::new(&mesh).map_err(|e| format!("stored polyhedron: {e}"))?;
+        Ok(Self { hull, volume: r.volume, inertia: r.inertia, form: r.form })
+    }
 }
 
 /// The component spheres of a bonded grain with its mass properties, precomputed once.
@@ -54,6 +119,7 @@ impl Shape {
             Shape::Sphere { radius } => four_thirds_pi * radius.powi(3),
             Shape::Ellipsoid { semi_axes: s } => four_thirds_pi * s.x * s.y * s.z,
             Shape::Bonded(b) => b.volume,
+            Shape::Polyhedron(p) => p.volume,
         }
     }
 
@@ -67,6 +133,7 @@ impl Shape {
                 Vector3::new(b2 + c2, a2 + c2, a2 + b2) * (m / 5.0)
             }
             Shape::Bonded(b) => b.inertia * density,
+            Shape::Polyhedron(p) => p.inertia * density,
         }
     }
 
@@ -76,6 +143,7 @@ impl Shape {
             Shape::Sphere { radius } => *radius,
             Shape::Ellipsoid { semi_axes } => semi_axes.max(),
             Shape::Bonded(b) => b.bounding_radius,
+            Shape::Polyhedron(p) => p.hull.bounding_radius(),
         }
     }
 
@@ -88,6 +156,7 @@ impl Shape {
                 FormParameters::from_unsorted((2.0 * semi_axes).into()).expect("positive semi-axes")
             }
             Shape::Bonded(b) => b.form,
+            Shape::Polyhedron(p) => p.form,
         }
     }
 
@@ -118,6 +187,9 @@ impl Shape {
                 let c = &b.spheres[k];
                 Piece::Sphere { center: position + orientation * c.center, radius: c.radius }
             }
+            (Shape::Polyhedron(p), _) => {
+                Piece::Polyhedron(PolyhedronPose::new(&p.hull, position, orientation.to_rotation_matrix().matrix()))
+            }
         }
     }
 
@@ -129,14 +201,17 @@ impl Shape {
         }
     }
 
-    /// A triangulated surface in the body frame, for visualisation: unit icospheres subdivided
-    /// `level` times, stretched to the shape (one per component sphere of a bonded grain).
+    /// A triangulated surface in the body frame, for visualisation: a polyhedron's own faces, or
+    /// unit icospheres subdivided `level` times, stretched to the shape (one per component
+    /// sphere of a bonded grain).
     pub fn surface(&self, level: usize) -> (Vec<Vector3<f64>>, Vec<[u32; 3]>) {
         let (unit, triangles) = unit_icosphere(level);
-        let stretched = |scale: Vector3<f64>, offset: Vector3<f64>| unit.iter().map(move |v| offset + v.component_mul(&scale));
+        let stretched =
+            |scale: Vector3<f64>, offset: Vector3<f64>| unit.iter().map(move |v| offset + v.component_mul(&scale));
         match self {
             Shape::Sphere { radius } => (stretched(Vector3::repeat(*radius), Vector3::zeros()).collect(), triangles),
             Shape::Ellipsoid { semi_axes } => (stretched(*semi_axes, Vector3::zeros()).collect(), triangles),
+            Shape::Polyhedron(p) => (p.hull.vertices().to_vec(), p.hull.triangles().to_vec()),
             Shape::Bonded(b) => {
                 let mut vertices = Vec::with_capacity(unit.len() * b.spheres.len());
                 let mut all = Vec::with_capacity(triangles.len() * b.spheres.len());

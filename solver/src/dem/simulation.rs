@@ -9,8 +9,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::body::{Bodies, NewBody};
-use super::contact::ellipsoid::EllipsoidPose;
 use super::contact;
+use super::contact::ellipsoid::EllipsoidPose;
 use super::contact_law::{Calibration, ContactHistory, LinearSpringDashpot};
 use super::domain::Domain;
 use super::neighbours::NeighbourList;

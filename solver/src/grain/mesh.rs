@@ -110,10 +110,16 @@ impl TriMesh {
     /// Reads an STL (ASCII or binary) or OBJ file, chosen by extension.
     pub fn from_file(path: &Path) -> Result<Self, MeshError> {
         let bytes = std::fs::read(path).map_err(|error| MeshError::Io { path: path.into(), error })?;
+        Self::from_bytes(&bytes, path)
+    }
+
+    /// Parses the bytes of an STL or OBJ file, the format chosen by the extension of `path`,
+    /// which errors also name.
+    pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Self, MeshError> {
         let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
         let (vertices, triangles) = match ext.as_deref() {
-            Some("stl") => parse_stl(&bytes),
-            Some("obj") => parse_obj(&bytes),
+            Some("stl") => parse_stl(bytes),
+            Some("obj") => parse_obj(bytes),
             _ => return Err(MeshError::Format { path: path.into() }),
         }
         .map_err(|(line, message)| MeshError::Parse { path: path.into(), line, message })?;

@@ -8,6 +8,7 @@ pub mod bonded;
 pub mod ellipsoid;
 pub mod form;
 pub mod form_distribution;
+pub mod library;
 pub mod mesh;
 pub mod pebble;
 pub mod simplify;
@@ -24,6 +25,7 @@ pub use form::{
     form_statistics,
 };
 pub use form_distribution::{DistributionError, FormDistribution, FormMoments, FormSampler};
+pub use library::{MeshLibrary, folder_meshes, rhine_meshes};
 pub use mesh::{MassProperties, MeshDefect, MeshError, TriMesh};
 pub use simplify::{Simplified, SimplifyError, simplify};
 pub use size::{SieveCurve, SizeError, SizeSampler, TABLE3, TABLE3_SIEVES, Table3Case};

@@ -20,23 +20,34 @@ pub struct ContactGeometry {
 use nalgebra::Matrix3;
 
 use self::ellipsoid::EllipsoidPose;
+use self::polyhedron::PolyhedronPose;
 use super::domain::Domain;
 
 /// One convex piece of a body in the world, as the narrow phase meets it: the body itself for a
-/// sphere or an ellipsoid, one component sphere of a bonded grain.
+/// sphere, an ellipsoid or a polyhedron, one component sphere of a bonded grain.
 #[derive(Clone, Copy)]
 pub enum Piece<'a> {
-    Sphere { center: Vector3<f64>, radius: f64 },
+    Sphere {
+        center: Vector3<f64>,
+        radius: f64,
+    },
     /// The body's ellipsoid at the current orientation, centred at `center` (the right image).
-    Ellipsoid { pose: &'a EllipsoidPose, center: Vector3<f64> },
+    Ellipsoid {
+        pose: &'a EllipsoidPose,
+        center: Vector3<f64>,
+    },
+    Polyhedron(PolyhedronPose<'a>),
 }
 
 impl Piece<'_> {
-    /// The piece as an ellipsoid; a sphere is the ellipsoid with equal axes.
+    /// A sphere or an ellipsoid as an ellipsoid; a sphere is the ellipsoid with equal axes.
     fn ellipsoid(&self) -> EllipsoidPose {
         match *self {
             Piece::Ellipsoid { pose, center } => pose.with_center(center),
-            Piece::Sphere { center, radius } => EllipsoidPose::new(center, &Matrix3::identity(), Vector3::repeat(radius)),
+            Piece::Sphere { center, radius } => {
+                EllipsoidPose::new(center, &Matrix3::identity(), Vector3::repeat(radius))
+            }
+            Piece::Polyhedron(_) => unreachable!("a polyhedron is met as a polyhedron"),
         }
     }
 
@@ -45,6 +56,7 @@ impl Piece<'_> {
         match *self {
             Piece::Sphere { radius, .. } => radius,
             Piece::Ellipsoid { pose, .. } => pose.smallest_semi_axis(),
+            Piece::Polyhedron(pose) => pose.shape().inner_radius(),
         }
     }
 }
@@ -66,8 +78,31 @@ pub fn between(a: &Piece, b: &Piece, warm: &mut Vector3<f64>) -> Option<ContactG
 #[inline(never)]
 fn curved(a: &Piece, b: &Piece, warm: &mut Vector3<f64>) -> Option<ContactGeometry> {
     let start = (*warm != Vector3::zeros()).then_some(*warm);
-    let (contact, stats) = ellipsoid::ellipsoid_ellipsoid_with_stats(&a.ellipsoid(), &b.ellipsoid(), start.as_ref());
-    *warm = match (&contact, stats.separating) {
+    let flip = |c: ContactGeometry| ContactGeometry { normal: -c.normal, ..c };
+    // Polyhedron queries find no separating direction to keep; the ellipsoid query does.
+    let (contact, separating) = match (a, b) {
+        (Piece::Polyhedron(pa), Piece::Polyhedron(pb)) => {
+            (polyhedron::polyhedron_polyhedron(pa, pb, start.as_ref()), None)
+        }
+        (Piece::Polyhedron(p), Piece::Sphere { center, radius }) => {
+            (polyhedron::polyhedron_sphere(p, center, *radius), None)
+        }
+        (Piece::Sphere { center, radius }, Piece::Polyhedron(p)) => {
+            (polyhedron::polyhedron_sphere(p, center, *radius).map(flip), None)
+        }
+        (Piece::Polyhedron(p), other) => {
+            (polyhedron::polyhedron_ellipsoid(p, &other.ellipsoid(), start.as_ref()), None)
+        }
+        (other, Piece::Polyhedron(p)) => {
+            (polyhedron::polyhedron_ellipsoid(p, &other.ellipsoid(), start.map(|n| -n).as_ref()).map(flip), None)
+        }
+        _ => {
+            let (contact, stats) =
+                ellipsoid::ellipsoid_ellipsoid_with_stats(&a.ellipsoid(), &b.ellipsoid(), start.as_ref());
+            (contact, stats.separating)
+        }
+    };
+    *warm = match (&contact, separating) {
         (Some(c), _) => c.normal,
         (None, Some(n)) => n,
         (None, None) => Vector3::zeros(),
@@ -81,6 +116,7 @@ pub fn with_floor(p: &Piece) -> Option<ContactGeometry> {
     match p {
         Piece::Sphere { center, radius } => sphere::sphere_floor(center, *radius),
         Piece::Ellipsoid { .. } => ellipsoid::ellipsoid_plane(&p.ellipsoid(), &Vector3::zeros(), &Vector3::z()),
+        Piece::Polyhedron(pose) => polyhedron::polyhedron_plane(pose, &Vector3::zeros(), &Vector3::z()),
     }
 }
 
@@ -92,5 +128,6 @@ pub fn with_wall(p: &Piece, domain: &Domain) -> Option<ContactGeometry> {
     match p {
         Piece::Sphere { center, radius } => sphere::sphere_cylinder_wall(center, *radius, c, c, c),
         Piece::Ellipsoid { .. } => ellipsoid::ellipsoid_cylinder_wall(&p.ellipsoid(), c, c, c),
+        Piece::Polyhedron(pose) => polyhedron::polyhedron_cylinder_wall(pose, c, c, c),
     }
 }

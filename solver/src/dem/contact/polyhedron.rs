@@ -164,6 +164,7 @@ pub struct ConvexPolyhedron {
     /// i + 3j + 9k (the centre entry is unused).
     starts: [u32; 27],
     bounding_radius: f64,
+    inner_radius: f64,
 }
 
 impl ConvexPolyhedron {
@@ -205,6 +206,8 @@ impl ConvexPolyhedron {
         let (neighbour_start, neighbours) = compressed(&adjacency);
         let (incident_start, incident) = compressed(&around);
         let bounding_radius = vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        let inner_radius =
+            triangles.iter().zip(&normals).map(|(t, n)| n.dot(&vertices[t[0] as usize])).fold(f64::INFINITY, f64::min);
         let mut shape = Self {
             vertices,
             neighbour_start,
@@ -215,6 +218,7 @@ impl ConvexPolyhedron {
             incident,
             starts: [0; 27],
             bounding_radius,
+            inner_radius,
         };
         for (cell, start) in shape.starts.iter_mut().enumerate() {
             let direction = V3::new((cell % 3) as f64 - 1.0, (cell / 3 % 3) as f64 - 1.0, (cell / 9) as f64 - 1.0);
@@ -233,6 +237,12 @@ impl ConvexPolyhedron {
 
     pub fn triangles(&self) -> &[[u32; 3]] {
         &self.triangles
+    }
+
+    /// Distance from the body origin to the nearest face plane: the radius of the largest ball
+    /// about the origin inside the polyhedron, the scale against which overlaps are judged.
+    pub fn inner_radius(&self) -> f64 {
+        self.inner_radius
     }
 
     /// Radius of the smallest sphere about the body origin that holds the polyhedron.
