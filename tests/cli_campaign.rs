@@ -102,6 +102,93 @@ fn a_grid_campaign_runs_once_and_reports() {
 }
 
 #[test]
+fn a_saved_model_predicts_what_its_formula_gives() {
+    // A model file as `sedpack report` writes it, with features the §7.3 relations can give.
+    let dir = tempfile::tempdir().unwrap();
+    let model = write(
+        dir.path(),
+        "model.json",
+        r#"{"name": "m", "features": ["inv_mean_EQ", "inv_std_EL"], "coefficients": [0.03, 0.002],
+            "intercept": 0.28, "cv": {"folds": 10, "mae": 0.004, "r2": 0.97},
+            "ranges": {"inv_mean_EQ": [1.5, 3.0], "inv_std_EL": [5.0, 10.0]}, "campaign": "c"}"#,
+    );
+    let out = ok(&[
+        "predict",
+        "--model",
+        &model,
+        "--mu-fl",
+        "0.6",
+        "--sigma-fl",
+        "0.15",
+        "--mu-el",
+        "0.7",
+        "--sigma-el",
+        "0.1",
+        "--json",
+    ]);
+    let v: Value = serde_json::from_str(&out).unwrap();
+    // By hand: μ_EQ = 0.6 · 0.7 = 0.42, so n = 0.03/0.42 + 0.002/0.1 + 0.28.
+    let expected = 0.03 / 0.42 + 0.002 / 0.1 + 0.28;
+    assert!((v["porosity"].as_f64().unwrap() - expected).abs() < 1e-12);
+    assert!(v["warnings"].as_array().unwrap().is_empty());
+    // σ_EL = 0.05 puts inv_std_EL = 20 outside the training range [5, 10]: a warning.
+    let out = ok(&[
+        "predict",
+        "--model",
+        &model,
+        "--mu-fl",
+        "0.6",
+        "--sigma-fl",
+        "0.15",
+        "--mu-el",
+        "0.7",
+        "--sigma-el",
+        "0.05",
+        "--json",
+    ]);
+    let v: Value = serde_json::from_str(&out).unwrap();
+    assert!(v["warnings"][0].as_str().unwrap().contains("inv_std_EL"));
+    // A CSV of measured grains gives every mixture feature: here two grains (FL, EL) of
+    // (0.5, 0.8) and (0.7, 0.6), so EQ = 0.4 and 0.42, μ_EQ = 0.41; EL has σ = 0.1.
+    let grains = write(dir.path(), "grains.csv", "FL,EL\n0.5,0.8\n0.7,0.6\n");
+    let out = ok(&["predict", "--model", &model, "--grains", &grains, "--json"]);
+    let v: Value = serde_json::from_str(&out).unwrap();
+    let expected = 0.03 / 0.41 + 0.002 / 0.1 + 0.28;
+    assert!((v["porosity"].as_f64().unwrap() - expected).abs() < 1e-12, "{v}");
+}
+
+#[test]
+fn ctrl_c_returns_running_jobs_to_pending() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "stop.yaml", &campaign("stop", 0.6));
+    let db = dir.path().join("stop.db");
+    let db = db.to_str().unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_sedpack"))
+        .args(["run", &file, "--db", db, "--workers", "1", "--quiet"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let rt = tokio::runtime::Runtime::new().unwrap();
+    let start = Instant::now();
+    while rt.block_on(async {
+        let Ok(store) = Store::open(db).await else { return true };
+        store.running_jobs("stop").await.map_or(true, |r| r.is_empty())
+    }) {
+        assert!(start.elapsed() < Duration::from_secs(60), "no job started");
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    assert!(Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap().success());
+    let out = child.wait_with_output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(stdout.contains("interrupted") && stdout.contains("sedpack resume stop"), "{stdout}");
+    let rows = rows(db, "stop");
+    assert!(rows.iter().all(|r| r.state != JobState::Running), "no job left running");
+    assert!(rows.iter().any(|r| r.state == JobState::Pending), "the interrupted job is pending again");
+}
+
+#[test]
 fn a_killed_runner_resumes_from_its_checkpoint_with_identical_results() {
     let dir = tempfile::tempdir().unwrap();
     let text = campaign("killed", 0.6);

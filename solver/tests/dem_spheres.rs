@@ -257,3 +257,26 @@ fn the_cylinder_wall_returns_the_restitution_coefficient() {
     let v = sim.bodies.velocity[0];
     assert!((-v.x / 0.4 - 0.1).abs() < 0.002 && v.y.abs() < 1e-12, "rebound velocity {v}");
 }
+
+#[test]
+fn unstable_setups_stop_with_a_clear_error() {
+    use solver::SolverError;
+    // Δt must resolve a collision in at least 10 steps.
+    let mut coarse = settings(0.1, 0.5, Vector3::zeros());
+    coarse.time_step = 5e-5;
+    assert!(matches!(
+        Simulation::new(Domain::Periodic { width: 0.05 }, coarse),
+        Err(SolverError::TimeStepTooLarge { .. })
+    ));
+    // Two spheres overlapping by 60 % of a radius: the step refuses to go on.
+    let mut sim = Simulation::new(Domain::Periodic { width: 0.05 }, settings(0.1, 0.5, Vector3::zeros())).unwrap();
+    sim.add_body(sphere(3e-3, Vector3::new(0.02, 0.02, 0.02), Vector3::zeros()));
+    sim.add_body(sphere(3e-3, Vector3::new(0.02 + 4.2e-3, 0.02, 0.02), Vector3::zeros()));
+    let error = sim.step().unwrap_err();
+    assert!(matches!(error, SolverError::Overlap { relative, .. } if (relative - 0.6).abs() < 1e-9));
+    assert!(error.to_string().contains("overlap"));
+    // A velocity that is not a number is caught at once.
+    let mut sim = Simulation::new(Domain::Periodic { width: 0.05 }, settings(0.1, 0.5, Vector3::zeros())).unwrap();
+    sim.add_body(sphere(3e-3, Vector3::new(0.02, 0.02, 0.02), Vector3::new(f64::NAN, 0.0, 0.0)));
+    assert!(matches!(sim.step(), Err(SolverError::NotFinite { .. })));
+}
