@@ -210,20 +210,15 @@ pub fn locate(text: &str, key: &str) -> Option<usize> {
     let lines: Vec<&str> = text.lines().collect();
     let segments: Vec<&str> = key.split('.').collect();
     let mut from = 0;
-    let mut found = None;
-    let mut s = 0;
-    while s < segments.len() {
+    for s in 0..segments.len() {
         // A grid key is itself dotted ("material.friction:"), so try the rest whole first.
         let rest = segments[s..].join(".");
         if let Some(at) = (from..lines.len()).find(|&k| has_key(lines[k], &rest)) {
             return Some(at + 1);
         }
-        let at = (from..lines.len()).find(|&k| has_key(lines[k], segments[s]))?;
-        found = Some(at + 1);
-        from = at;
-        s += 1;
+        from = (from..lines.len()).find(|&k| has_key(lines[k], segments[s]))?;
     }
-    found
+    None
 }
 
 fn has_key(line: &str, key: &str) -> bool {

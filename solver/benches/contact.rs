@@ -7,29 +7,20 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use solver::dem::contact::ellipsoid::{
     EllipsoidPose, ellipsoid_cylinder_wall, ellipsoid_ellipsoid, ellipsoid_ellipsoid_with_stats, ellipsoid_plane,
 };
+use solver::dem::uniform_rotation;
 
 type V3 = Vector3<f64>;
 
 const PAIRS: usize = 1024;
 
 fn random_rotation(rng: &mut ChaCha8Rng) -> UnitQuaternion<f64> {
-    loop {
-        let q = Quaternion::new(
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-        );
-        if (0.01..1.0).contains(&q.norm()) {
-            return UnitQuaternion::from_quaternion(q);
-        }
-    }
+    uniform_rotation(rng)
 }
 
 fn random_unit(rng: &mut ChaCha8Rng) -> V3 {

@@ -12,13 +12,14 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use parry3d_f64::math::{Pose, Rotation as PRotation, Vector as PVector};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use solver::dem::contact::polyhedron::{
     ConvexPolyhedron, PolyhedronPose, polyhedron_plane, polyhedron_polyhedron, polyhedron_polyhedron_with_stats,
 };
+use solver::dem::uniform_rotation;
 use solver::grain::pebble::pebble;
 use solver::grain::simplify;
 
@@ -28,17 +29,7 @@ const PAIRS: usize = 1024;
 const SHAPES: usize = 16;
 
 fn random_rotation(rng: &mut ChaCha8Rng) -> UnitQuaternion<f64> {
-    loop {
-        let q = Quaternion::new(
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-        );
-        if (0.01..1.0).contains(&q.norm()) {
-            return UnitQuaternion::from_quaternion(q);
-        }
-    }
+    uniform_rotation(rng)
 }
 
 fn random_unit(rng: &mut ChaCha8Rng) -> V3 {

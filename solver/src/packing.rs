@@ -5,7 +5,7 @@
 
 use std::time::{Duration, Instant};
 
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::Vector3;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -13,7 +13,7 @@ use thiserror::Error;
 
 use crate::SolverError;
 use crate::dem::shape::Polyhedron;
-use crate::dem::{Calibration, Domain, NewBody, Settings, Shaking, Shape, Simulation};
+use crate::dem::{Calibration, Domain, NewBody, Settings, Shaking, Shape, Simulation, uniform_rotation};
 use crate::grain::{
     FormDistribution, FormParameters, FormStatistic, MeshLibrary, SieveCurve, SizeSampler, bonded_grain,
     form_statistics,
@@ -372,7 +372,7 @@ impl Packing {
                 )),
                 (ShapeKind::Mesh, None) => unreachable!("a mesh was drawn for a mesh packing"),
             };
-            let orientation = random_rotation(&mut self.rng);
+            let orientation = uniform_rotation(&mut self.rng);
             let mut spin = || self.rng.random_range(-0.1..0.1) * u;
             let velocity = Vector3::new(spin(), spin(), -u);
             let angular_velocity = Vector3::new(spin(), spin(), spin()) / size;
@@ -449,17 +449,4 @@ fn generation_grid(spec: &PackingSpec) -> Vec<Vector3<f64>> {
         }
     }
     grid
-}
-
-/// A rotation drawn uniformly from SO(3) (Shoemake's method).
-fn random_rotation(rng: &mut ChaCha8Rng) -> UnitQuaternion<f64> {
-    let (u1, u2, u3): (f64, f64, f64) = (rng.random(), rng.random(), rng.random());
-    let tau = 2.0 * std::f64::consts::PI;
-    let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
-    UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
-        b * (tau * u3).cos(),
-        a * (tau * u2).sin(),
-        a * (tau * u2).cos(),
-        b * (tau * u3).sin(),
-    ))
 }

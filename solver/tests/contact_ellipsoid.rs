@@ -6,13 +6,14 @@
 //! through the library's Q, and find minima by a dense latitude–longitude grid, a compass search
 //! and a Newton polish whose Jacobian is taken by finite differences.
 
-use nalgebra::{Matrix2, Matrix3, Quaternion, UnitQuaternion, Vector2, Vector3};
+use nalgebra::{Matrix2, Matrix3, UnitQuaternion, Vector2, Vector3};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use solver::dem::contact::ContactGeometry;
 use solver::dem::contact::ellipsoid::{
     EllipsoidPose, ellipsoid_cylinder_wall, ellipsoid_ellipsoid, ellipsoid_ellipsoid_with_stats, ellipsoid_plane,
 };
+use solver::dem::uniform_rotation;
 
 type V3 = Vector3<f64>;
 
@@ -65,18 +66,7 @@ impl Body {
 }
 
 fn random_rotation(rng: &mut ChaCha8Rng) -> Matrix3<f64> {
-    loop {
-        let q = Quaternion::new(
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-        );
-        // Rejection from the 4-ball makes the rotation uniform.
-        if (0.01..1.0).contains(&q.norm()) {
-            return UnitQuaternion::from_quaternion(q).to_rotation_matrix().into_inner();
-        }
-    }
+    uniform_rotation(rng).to_rotation_matrix().into_inner()
 }
 
 /// Semi-axes of `scale` × [1, 10] each: aspect ratios up to 10:1.

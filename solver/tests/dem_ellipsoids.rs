@@ -3,24 +3,12 @@
 //! flattest side.
 
 use nalgebra::{UnitQuaternion, Vector3};
-use solver::dem::{Calibration, Domain, NewBody, Settings, Shape, Simulation};
+mod common;
+
+use common::{momenta, settings};
+use solver::dem::{Calibration, Domain, NewBody, Shape, Simulation};
 
 const G: f64 = 9.81;
-
-fn settings(restitution: f64, friction: f64, gravity: Vector3<f64>) -> Settings {
-    Settings {
-        density: 2650.0,
-        fluid_density: 1000.0,
-        gravity,
-        restitution,
-        collision_time: 2e-4,
-        poisson_ratio: 0.22,
-        friction,
-        time_step: 5e-6,
-        skin: 1e-3,
-        calibration: Calibration::Discrete { time_step: 5e-6 },
-    }
-}
 
 fn ellipsoid(
     axes: [f64; 3],
@@ -35,17 +23,6 @@ fn ellipsoid(
         velocity,
         angular_velocity: Vector3::zeros(),
     }
-}
-
-fn momenta(sim: &Simulation) -> (Vector3<f64>, Vector3<f64>) {
-    let b = &sim.bodies;
-    let mut p = Vector3::zeros();
-    let mut l = Vector3::zeros();
-    for k in 0..b.len() {
-        p += b.mass[k] * b.velocity[k];
-        l += b.mass[k] * b.position[k].cross(&b.velocity[k]) + b.world_inertia(k) * b.angular_velocity[k];
-    }
-    (p, l)
 }
 
 /// Runs until the bodies separate after their first contact; returns the contact steps.

@@ -4,28 +4,13 @@
 
 mod common;
 
-use common::box_mesh;
+use common::{box_mesh, momenta, settings};
 use nalgebra::{UnitQuaternion, Vector3};
 use solver::dem::shape::Polyhedron;
-use solver::dem::{Calibration, Domain, NewBody, Settings, Shape, Simulation};
+use solver::dem::{Domain, NewBody, Shape, Simulation};
 use solver::grain::{FormParameters, TriMesh, bonded_grain};
 
 const G: f64 = 9.81;
-
-fn settings(friction: f64, gravity: Vector3<f64>) -> Settings {
-    Settings {
-        density: 2650.0,
-        fluid_density: 1000.0,
-        gravity,
-        restitution: 0.1,
-        collision_time: 2e-4,
-        poisson_ratio: 0.22,
-        friction,
-        time_step: 5e-6,
-        skin: 1e-3,
-        calibration: Calibration::Discrete { time_step: 5e-6 },
-    }
-}
 
 fn cube(side: f64) -> Shape {
     let (v, t) = box_mesh(side, side, side);
@@ -41,7 +26,7 @@ fn body(shape: Shape, position: Vector3<f64>, orientation: UnitQuaternion<f64>, 
 fn cube_on_slope(theta_degrees: f64, time: f64) -> (f64, f64) {
     let theta = theta_degrees.to_radians();
     let g = Vector3::new(G * theta.sin(), 0.0, -G * theta.cos());
-    let mut sim = Simulation::new(Domain::Periodic { width: 0.1 }, settings(0.5, g)).unwrap();
+    let mut sim = Simulation::new(Domain::Periodic { width: 0.1 }, settings(0.1, 0.5, g)).unwrap();
     sim.add_body(body(cube(0.01), Vector3::new(0.05, 0.05, 0.005), UnitQuaternion::identity(), Vector3::zeros()));
     for _ in 0..4000 {
         sim.step().unwrap();
@@ -80,7 +65,8 @@ fn a_cube_dropped_on_its_corner_comes_to_rest_on_a_face() {
     let diagonal = Vector3::new(1.0, 1.0, 1.0).normalize();
     let onto_corner = UnitQuaternion::rotation_between(&diagonal, &Vector3::z()).unwrap();
     let tip = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), 3f64.to_radians());
-    let mut sim = Simulation::new(Domain::Periodic { width: 0.1 }, settings(0.5, Vector3::new(0.0, 0.0, -G))).unwrap();
+    let mut sim =
+        Simulation::new(Domain::Periodic { width: 0.1 }, settings(0.1, 0.5, Vector3::new(0.0, 0.0, -G))).unwrap();
     sim.add_body(body(cube(0.01), Vector3::new(0.05, 0.05, 0.0095), tip * onto_corner, Vector3::zeros()));
     for _ in 0..60_000 {
         sim.step().unwrap();
@@ -107,7 +93,7 @@ fn rod(length: f64) -> Shape {
 fn bonded_rods_meeting_end_on_rebound_with_the_restitution_coefficient() {
     // End spheres meet on the rods' common axis: a central collision of two rigid bodies, so the
     // pair rebounds with e_n after T_c like two spheres of the rods' masses.
-    let mut sim = Simulation::new(Domain::Periodic { width: 0.1 }, settings(0.5, Vector3::zeros())).unwrap();
+    let mut sim = Simulation::new(Domain::Periodic { width: 0.1 }, settings(0.1, 0.5, Vector3::zeros())).unwrap();
     sim.add_body(body(
         rod(9e-3),
         Vector3::new(0.03, 0.05, 0.05),
@@ -133,7 +119,7 @@ fn bonded_rods_meeting_end_on_rebound_with_the_restitution_coefficient() {
 
 #[test]
 fn an_oblique_collision_of_bonded_grains_conserves_momentum() {
-    let mut sim = Simulation::new(Domain::Periodic { width: 0.1 }, settings(0.5, Vector3::zeros())).unwrap();
+    let mut sim = Simulation::new(Domain::Periodic { width: 0.1 }, settings(0.1, 0.5, Vector3::zeros())).unwrap();
     let disk = Shape::from(&bonded_grain(&FormParameters::new(9e-3, 6.6e-3, 3e-3).unwrap()).unwrap());
     let turn = UnitQuaternion::from_euler_angles(0.4, 0.9, -0.3);
     sim.add_body(body(
@@ -143,15 +129,6 @@ fn an_oblique_collision_of_bonded_grains_conserves_momentum() {
         Vector3::new(0.6, 0.05, 0.0),
     ));
     sim.add_body(body(disk, Vector3::new(0.0385, 0.0522, 0.0508), turn, Vector3::new(-0.4, 0.0, 0.02)));
-    let momenta = |sim: &Simulation| {
-        let b = &sim.bodies;
-        let (mut p, mut l) = (Vector3::zeros(), Vector3::zeros());
-        for k in 0..2 {
-            p += b.mass[k] * b.velocity[k];
-            l += b.mass[k] * b.position[k].cross(&b.velocity[k]) + b.world_inertia(k) * b.angular_velocity[k];
-        }
-        (p, l)
-    };
     let (p0, l0) = momenta(&sim);
     let mut touched = false;
     while !(touched && sim.contacts == 0) {
@@ -168,7 +145,8 @@ fn an_oblique_collision_of_bonded_grains_conserves_momentum() {
 #[test]
 fn a_bonded_rod_dropped_on_end_comes_to_rest_lying_down() {
     let standing = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), std::f64::consts::FRAC_PI_2 - 0.1);
-    let mut sim = Simulation::new(Domain::Periodic { width: 0.1 }, settings(0.5, Vector3::new(0.0, 0.0, -G))).unwrap();
+    let mut sim =
+        Simulation::new(Domain::Periodic { width: 0.1 }, settings(0.1, 0.5, Vector3::new(0.0, 0.0, -G))).unwrap();
     sim.add_body(body(rod(9e-3), Vector3::new(0.05, 0.05, 6e-3), standing, Vector3::zeros()));
     for _ in 0..60_000 {
         sim.step().unwrap();

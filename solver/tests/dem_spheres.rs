@@ -2,24 +2,12 @@
 //! friction and rolling on a slope (Eq. 7), conservation laws.
 
 use nalgebra::{UnitQuaternion, Vector3};
-use solver::dem::{Calibration, Domain, NewBody, Settings, Shape, Simulation};
+mod common;
+
+use common::{momenta, settings};
+use solver::dem::{Calibration, Domain, NewBody, Shape, Simulation};
 
 const G: f64 = 9.81;
-
-fn settings(restitution: f64, friction: f64, gravity: Vector3<f64>) -> Settings {
-    Settings {
-        density: 2650.0,
-        fluid_density: 1000.0,
-        gravity,
-        restitution,
-        collision_time: 2e-4,
-        poisson_ratio: 0.22,
-        friction,
-        time_step: 5e-6,
-        skin: 1e-3,
-        calibration: Calibration::Discrete { time_step: 5e-6 },
-    }
-}
 
 fn sphere(radius: f64, position: Vector3<f64>, velocity: Vector3<f64>) -> NewBody {
     NewBody {
@@ -204,16 +192,6 @@ fn oblique_frictional_collision_conserves_linear_and_angular_momentum() {
     let mut sim = Simulation::new(Domain::Periodic { width: 0.1 }, settings(0.1, 0.5, Vector3::zeros())).unwrap();
     sim.add_body(sphere(3e-3, Vector3::new(0.03, 0.05, 0.05), Vector3::new(0.6, 0.1, 0.0)));
     sim.add_body(sphere(4e-3, Vector3::new(0.0375, 0.053, 0.0513), Vector3::new(-0.4, 0.0, 0.05)));
-    let momenta = |sim: &Simulation| {
-        let b = &sim.bodies;
-        let mut p = Vector3::zeros();
-        let mut l = Vector3::zeros();
-        for k in 0..2 {
-            p += b.mass[k] * b.velocity[k];
-            l += b.mass[k] * b.position[k].cross(&b.velocity[k]) + b.world_inertia(k) * b.angular_velocity[k];
-        }
-        (p, l)
-    };
     let (p0, l0) = momenta(&sim);
     let (_, sim) = collide(sim);
     let (p1, l1) = momenta(&sim);

@@ -1,7 +1,8 @@
 //! Rigid bodies stored as arrays (one entry per grain), so that the per-step loops stream
 //! through memory.
 
-use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
+use rand::{Rng, RngExt};
 use serde::{Deserialize, Serialize};
 
 use super::shape::Shape;
@@ -76,4 +77,17 @@ impl Bodies {
             })
             .sum()
     }
+}
+
+/// A rotation drawn uniformly from SO(3) (Shoemake's method).
+pub fn uniform_rotation<R: Rng + ?Sized>(rng: &mut R) -> UnitQuaternion<f64> {
+    let (u1, u2, u3): (f64, f64, f64) = (rng.random(), rng.random(), rng.random());
+    let tau = 2.0 * std::f64::consts::PI;
+    let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
+    UnitQuaternion::from_quaternion(Quaternion::new(
+        b * (tau * u3).cos(),
+        a * (tau * u2).sin(),
+        a * (tau * u2).cos(),
+        b * (tau * u3).sin(),
+    ))
 }

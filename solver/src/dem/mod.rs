@@ -9,7 +9,7 @@ pub mod neighbours;
 pub mod shape;
 pub mod simulation;
 
-pub use body::{Bodies, NewBody};
+pub use body::{Bodies, NewBody, uniform_rotation};
 pub use contact::ContactGeometry;
 pub use contact_law::{Calibration, ContactHistory, LinearSpringDashpot};
 pub use domain::Domain;

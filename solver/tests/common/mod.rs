@@ -53,3 +53,31 @@ pub fn ellipsoid_mesh(a: f64, b: f64, c: f64, rings: usize) -> (Vec<Vector3<f64>
 pub fn rhine_mesh_path(k: usize) -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("meshes/rhine_scan_{k}.obj"))
 }
+
+/// The paper's material and time step (§4.2) with the given restitution, friction and gravity
+/// (gravity tilted for slopes), a 1 mm skin and the discrete calibration.
+pub fn settings(restitution: f64, friction: f64, gravity: Vector3<f64>) -> solver::dem::Settings {
+    solver::dem::Settings {
+        density: 2650.0,
+        fluid_density: 1000.0,
+        gravity,
+        restitution,
+        collision_time: 2e-4,
+        poisson_ratio: 0.22,
+        friction,
+        time_step: 5e-6,
+        skin: 1e-3,
+        calibration: solver::dem::Calibration::Discrete { time_step: 5e-6 },
+    }
+}
+
+/// Total linear momentum and angular momentum about the origin of all bodies.
+pub fn momenta(sim: &solver::dem::Simulation) -> (Vector3<f64>, Vector3<f64>) {
+    let b = &sim.bodies;
+    let (mut p, mut l) = (Vector3::zeros(), Vector3::zeros());
+    for k in 0..b.len() {
+        p += b.mass[k] * b.velocity[k];
+        l += b.mass[k] * b.position[k].cross(&b.velocity[k]) + b.world_inertia(k) * b.angular_velocity[k];
+    }
+    (p, l)
+}
