@@ -150,9 +150,16 @@ pub struct EvaluationFile {
     pub trim: Option<Auto>,
 }
 
+/// A measured porosity, or `table3`: the laboratory value of Table 3 for the named size case.
+#[derive(Debug)]
+pub enum ExperimentFile {
+    Table3,
+    Measured(MeasuredFile),
+}
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct ExperimentFile {
+pub struct MeasuredFile {
     pub porosity: f64,
     pub std: Option<f64>,
 }
@@ -442,10 +449,14 @@ pub fn resolve(file: JobFile, source: &Source) -> anyhow::Result<JobSpec> {
         Auto::Value(t) => Some(check(source, "evaluation.trim", t, t >= 0.0, "a height ≥ 0")?),
     };
     let experiment = match file.experiment {
-        Some(x) => {
+        Some(ExperimentFile::Measured(x)) => {
             check(source, "experiment.porosity", x.porosity, (0.0..1.0).contains(&x.porosity), "a porosity in [0, 1)")?;
             Some(Experiment { porosity: x.porosity, std: x.std })
         }
+        Some(ExperimentFile::Table3) => match Table3Case::find(&size_case) {
+            Some(case) => Some(Experiment { porosity: case.porosity, std: Some(case.porosity_std) }),
+            None => return Err(source.error("experiment", "`table3` needs grains.size to be a case of Table 3")),
+        },
         None => None,
     };
 
@@ -573,5 +584,24 @@ impl<'de> Deserialize<'de> for FormFile {
             }
         }
         deserializer.deserialize_any(FormVisitor)
+    }
+}
+
+impl<'de> Deserialize<'de> for ExperimentFile {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct ExperimentVisitor;
+        impl<'de> Visitor<'de> for ExperimentVisitor {
+            type Value = ExperimentFile;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("{porosity, std} or `table3`")
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<ExperimentFile, E> {
+                if v == "table3" { Ok(ExperimentFile::Table3) } else { Err(E::invalid_value(de::Unexpected::Str(v), &self)) }
+            }
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<ExperimentFile, A::Error> {
+                Ok(ExperimentFile::Measured(MeasuredFile::deserialize(de::value::MapAccessDeserializer::new(map))?))
+            }
+        }
+        deserializer.deserialize_any(ExperimentVisitor)
     }
 }
