@@ -596,7 +596,11 @@ impl<'de> Deserialize<'de> for ExperimentFile {
                 f.write_str("{porosity, std} or `table3`")
             }
             fn visit_str<E: de::Error>(self, v: &str) -> Result<ExperimentFile, E> {
-                if v == "table3" { Ok(ExperimentFile::Table3) } else { Err(E::invalid_value(de::Unexpected::Str(v), &self)) }
+                if v == "table3" {
+                    Ok(ExperimentFile::Table3)
+                } else {
+                    Err(E::invalid_value(de::Unexpected::Str(v), &self))
+                }
             }
             fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<ExperimentFile, A::Error> {
                 Ok(ExperimentFile::Measured(MeasuredFile::deserialize(de::value::MapAccessDeserializer::new(map))?))

@@ -128,7 +128,6 @@ impl LinearSpringDashpot {
             displacement = -(tangential + dt_damping * ut) / kt;
         }
         history.tangential_displacement = displacement;
-        history.normal = n;
         normal_magnitude * n + tangential
     }
 }

@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::body::Bodies;
 use super::contact_law::ContactHistory;
 use super::domain::Domain;
+use super::shape::Shape;
 use crate::SolverError;
 
 /// A piece of body i and a piece of body j > i (with j moved by whole periods `image`, a
@@ -20,6 +21,8 @@ pub struct Pair {
     pub image: [i16; 2],
     /// Piece of i and piece of j.
     pub pieces: [u16; 2],
+    /// Both bodies are spheres (radius = bounding radius): the analytic contact needs no shape.
+    pub spheres: bool,
     /// m_i m_j / (m_i + m_j), the mass of Eq. 11, kept here to spare a division per step.
     pub effective_mass: f64,
 }
@@ -228,8 +231,18 @@ impl NeighbourList {
                             for image in domain.images_within(&xi, &bodies.position[j], reach) {
                                 let xj = bodies.position[j] + domain.shift(image);
                                 if (xj - xi).norm_squared() < reach * reach {
-                                    let body_pair =
-                                        Pair { i: i as u32, j: j as u32, image, pieces: [0, 0], effective_mass };
+                                    let spheres = matches!(
+                                        (&bodies.shape[i], &bodies.shape[j]),
+                                        (Shape::Sphere { .. }, Shape::Sphere { .. })
+                                    );
+                                    let body_pair = Pair {
+                                        i: i as u32,
+                                        j: j as u32,
+                                        image,
+                                        pieces: [0, 0],
+                                        spheres,
+                                        effective_mass,
+                                    };
                                     push_piece_pairs(&mut self.pairs, body_pair, bodies, xj, self.skin);
                                 }
                             }

@@ -170,9 +170,23 @@ impl Shape {
     }
 
     /// Piece `k` of a body at `position` turned by `orientation` (with its ellipsoid `pose` for
-    /// an ellipsoid).
-    #[inline]
+    /// an ellipsoid). Inline for the sphere, the rest out of line.
+    #[inline(always)]
     pub fn piece<'a>(
+        &'a self,
+        k: usize,
+        position: Vector3<f64>,
+        orientation: &UnitQuaternion<f64>,
+        pose: Option<&'a EllipsoidPose>,
+    ) -> Piece<'a> {
+        match self {
+            Shape::Sphere { radius } => Piece::Sphere { center: position, radius: *radius },
+            _ => self.non_spherical_piece(k, position, orientation, pose),
+        }
+    }
+
+    #[inline(never)]
+    fn non_spherical_piece<'a>(
         &'a self,
         k: usize,
         position: Vector3<f64>,

@@ -201,10 +201,18 @@ impl Simulation {
                 let (i, j) = (pair.i as usize, pair.j as usize);
                 let xi = bodies.position[i];
                 let xj = bodies.position[j] + domain.shift(pair.image);
-                let [ka, kb] = pair.pieces.map(usize::from);
-                let a = bodies.shape[i].piece(ka, xi, &bodies.orientation[i], poses[i].as_ref());
-                let b = bodies.shape[j].piece(kb, xj, &bodies.orientation[j], poses[j].as_ref());
-                let Some(geometry) = contact::between(&a, &b, &mut history.normal) else {
+                let (geometry, scale) = if pair.spheres {
+                    // Sphere beds spend most of their time here: no shape to load, no piece to build.
+                    let (ra, rb) = (bodies.bounding_radius[i], bodies.bounding_radius[j]);
+                    (contact::sphere::sphere_sphere(&xi, ra, &xj, rb), ra.min(rb))
+                } else {
+                    let [ka, kb] = pair.pieces.map(usize::from);
+                    let a = bodies.shape[i].piece(ka, xi, &bodies.orientation[i], poses[i].as_ref());
+                    let b = bodies.shape[j].piece(kb, xj, &bodies.orientation[j], poses[j].as_ref());
+                    let scale = a.smallest_half_extent().min(b.smallest_half_extent());
+                    (contact::between(&a, &b, &mut history.normal), scale)
+                };
+                let Some(geometry) = geometry else {
                     history.tangential_displacement = Vector3::zeros();
                     *out = PairForce::default();
                     return (0, 0.0);
@@ -214,7 +222,6 @@ impl Simulation {
                 let relative = bodies.point_velocity(j, &arm_j) - bodies.point_velocity(i, &arm_i);
                 let force = law.force(pair.effective_mass, &geometry, &relative, history, dt);
                 *out = PairForce { force, torque_i: force.cross(&arm_i), torque_j: arm_j.cross(&force) };
-                let scale = a.smallest_half_extent().min(b.smallest_half_extent());
                 (1, geometry.depth / scale)
             })
             .reduce(|| (0, 0.0), |a, b| (a.0 + b.0, a.1.max(b.1)))
