@@ -103,7 +103,13 @@ fn bad_job_files_name_the_file_line_and_key() {
     fails(&["pack", &grid], &["grid.yaml:1", "sedpack run"]);
     let spheres = write(dir.path(), "spheres.yaml", "grains: {shape: sphere, form: {fl: 0.5, el: 0.5}}\n");
     fails(&["pack", &spheres], &["grains.form", "spheres"]);
+    // A grid slot narrower than the smallest grain, or a negative spread of a measurement.
+    let spacing = write(dir.path(), "spacing.yaml", "process:\n  generation: {spacing: 1.0e-9}\n");
+    fails(&["pack", &spacing], &["spacing.yaml:2", "process.generation.spacing", "smallest sieve"]);
+    let std = write(dir.path(), "std.yaml", "experiment: {porosity: 0.35, std: -0.01}\n");
+    fails(&["pack", &std], &["std.yaml:1", "experiment.std"]);
     fails(&["pack", "/no/such/job.yaml"], &["/no/such/job.yaml"]);
+    fails(&["run", "/no/such/campaign.yaml", "--checkpoint-interval=-1"], &["--checkpoint-interval"]);
 }
 
 #[test]
@@ -134,6 +140,7 @@ fn porosity_command_evaluates_a_lattice_and_rejects_bad_rows() {
     let missing = write(dir.path(), "missing.csv", "x,y,z\n0,0,0\n");
     fails(&["porosity", &missing, "--width", "0.01", "--trim", "0"], &["missing.csv", "'r'"]);
     fails(&["porosity", &path, "--width", "-1", "--trim", "0"], &["--width"]);
+    fails(&["porosity", &path, "--width", "0.01", "--slice", "1e-12", "--trim", "0"], &["slices of 1e-12 m"]);
 }
 
 /// An OBJ of a 10 mm box with one face pushed in: closed and valid, but not convex.

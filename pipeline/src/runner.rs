@@ -22,7 +22,7 @@ use crate::spec::JobSpec;
 const HEARTBEAT: Duration = Duration::from_secs(10);
 /// A job whose heartbeat is older than this belongs to a dead runner.
 const STALE_AFTER: Duration = Duration::from_secs(60);
-/// Time steps between progress reports and cancellation checks (0.05 s simulated).
+/// Time steps between progress reports and cancellation checks (0.05 s simulated at the default Δt).
 const STEPS_PER_REPORT: u64 = 10_000;
 
 #[derive(Debug, Clone)]
@@ -175,7 +175,7 @@ impl Worker {
                 None => break,
             };
             let label: Vec<String> = claimed.parameters.iter().map(|(k, v)| format!("{k}={v}")).collect();
-            let label = format!("{} ({})", &claimed.id[..8], label.join(", "));
+            let label = format!("{} ({})", claimed.id.get(..8).unwrap_or(&claimed.id), label.join(", "));
             info!(job = %claimed.id, worker = %self.id, attempt = claimed.attempts, "started");
             let outcome = match read_spec(&claimed.spec) {
                 Ok(spec) => self.execute(&claimed.id, spec, &label, pool.clone()).await?,

@@ -14,10 +14,6 @@ use solver::packing::{FormSpec, GrainSpec, Material, PackingSpec, Process, Shape
 
 use crate::meshes;
 
-/// The Rhine form distribution of Table 2, the default for non-spherical grains.
-pub const RHINE_FORMS: FormDistribution =
-    FormDistribution { mu_fl: 0.647, sigma_fl: 0.175, mu_el: 0.682, sigma_el: 0.139 };
-
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct JobFile {
@@ -350,7 +346,7 @@ pub fn resolve(file: JobFile, source: &Source) -> anyhow::Result<JobSpec> {
         (_, Some(FormFile::Own)) => {
             return Err(source.error("grains.form", "`mesh` (each mesh's own form) needs grains.shape: mesh"));
         }
-        (_, None) => FormSpec::Distribution(RHINE_FORMS),
+        (_, None) => FormSpec::Distribution(solver::grain::pebble::RHINE_FORMS),
         (_, Some(FormFile::Single { fl, el })) => {
             check(source, "grains.form.fl", fl, fl > 0.0 && fl <= 1.0, "a flatness in (0, 1]")?;
             check(source, "grains.form.el", el, el > 0.0 && el <= 1.0, "an elongation in (0, 1]")?;
@@ -395,7 +391,7 @@ pub fn resolve(file: JobFile, source: &Source) -> anyhow::Result<JobSpec> {
         source,
         "solver.time_step",
         time_step,
-        steps_per_collision >= 10.0,
+        steps_per_collision >= solver::dem::MIN_STEPS_PER_COLLISION,
         "at most material.collision_time / 10 (the paper resolves a collision in 40 steps)",
     )?;
     let calibration = match s.calibration.unwrap_or(CalibrationFile::Discrete) {
@@ -409,7 +405,16 @@ pub fn resolve(file: JobFile, source: &Source) -> anyhow::Result<JobSpec> {
         size.sieves()[last + 1]
     };
     let spacing = match generation.spacing.unwrap_or(Auto::Auto) {
-        Auto::Value(v) => positive(source, "process.generation.spacing", v)?,
+        Auto::Value(v) => {
+            let smallest = size.sieves()[size.fractions().iter().position(|&f| f > 0.0).unwrap_or(0)];
+            check(
+                source,
+                "process.generation.spacing",
+                v,
+                v >= smallest,
+                &format!("at least the smallest sieve in use, {smallest} m (a grid slot holds a grain)"),
+            )?
+        }
         Auto::Auto => table_spacing.unwrap_or(largest_present),
     };
     let velocity = generation.velocity.unwrap_or(1.0);
@@ -451,6 +456,9 @@ pub fn resolve(file: JobFile, source: &Source) -> anyhow::Result<JobSpec> {
     let experiment = match file.experiment {
         Some(ExperimentFile::Measured(x)) => {
             check(source, "experiment.porosity", x.porosity, (0.0..1.0).contains(&x.porosity), "a porosity in [0, 1)")?;
+            if let Some(std) = x.std {
+                check(source, "experiment.std", std, std >= 0.0, "a standard deviation ≥ 0")?;
+            }
             Some(Experiment { porosity: x.porosity, std: x.std })
         }
         Some(ExperimentFile::Table3) => match Table3Case::find(&size_case) {

@@ -123,7 +123,10 @@ pub enum PackingError {
     Solver(#[from] SolverError),
     #[error(transparent)]
     Porosity(#[from] PorosityError),
-    #[error("process.spacing = {spacing} m leaves no grid position in the generation region of the domain")]
+    #[error(
+        "process.generation.spacing = {spacing} m leaves no grid position in the generation region \
+         z ∈ [0.6, 1]·H of the domain (raise domain.height or lower the spacing)"
+    )]
     NoGridPositions { spacing: f64 },
     #[error("not converged after solver.max_time = {0} s of simulated time")]
     NotConverged(f64),
@@ -261,10 +264,6 @@ impl Packing {
             }
             _ => Err(PackingError::Meshes(format!("{}: not the meshes this packing was started with", library.source))),
         }
-    }
-
-    pub fn phase(&self) -> Phase {
-        self.phase
     }
 
     pub fn progress(&self) -> Progress {

@@ -26,7 +26,12 @@ pub enum PorosityError {
     NoSurface(f64),
     #[error("the packing (surface at {surface} m) is too thin for the trim of {trim} m at both ends")]
     TooThin { surface: f64, trim: f64 },
+    #[error("slices of {slice:e} m cut a packing {height} m high into more than {MAX_SLICES} slices")]
+    TooManySlices { slice: f64, height: f64 },
 }
+
+/// More slices than this mean a slice thickness mistaken for another unit, not a wish.
+pub const MAX_SLICES: f64 = 1e7;
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ProfilePoint {
@@ -66,6 +71,9 @@ pub fn evaluate(spheres: &[(f64, f64)], area: f64, settings: &PorositySettings) 
     }
     let h = settings.slice;
     let top = spheres.iter().map(|(z, r)| z + r).fold(f64::NEG_INFINITY, f64::max);
+    if top / h > MAX_SLICES {
+        return Err(PorosityError::TooManySlices { slice: h, height: top });
+    }
     // One more slice than the grains reach, so that the top slice is empty.
     let count = (top / h).ceil().max(0.0) as usize + 1;
     let mut solid = vec![0.0; count];

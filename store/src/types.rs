@@ -79,7 +79,7 @@ pub struct JobResult {
     /// s of simulated time.
     pub simulated_time: f64,
     pub steps: u64,
-    /// s of wall-clock time, as measured by the runner.
+    /// s of wall-clock time spent stepping, measured by the solver and summed over resumed attempts.
     pub wall_time: f64,
     pub solver_version: String,
 }

@@ -572,7 +572,7 @@ fn sets_section(blocks: &mut Vec<Block>, d: &Dataset, s: &Selection) -> Result<(
     let cv = model.cv.expect("fitted models carry their cross-validation");
     blocks.push(Block::Subheading("Chosen model".into()));
     blocks.push(Block::Paragraph(format!(
-        "Like the paper (§6.3.3, §7.2: \"generally include all four features\"), the largest feature set the procedure built is kept (ties to the smaller MAE): **{}**, fitted on all {} packings. Cross-validation ({}-fold): MAE = {:.2}×10⁻³, R² = {:.3}. Saved as `models/{}`; apply it with `sedpack predict --model models/{}`.",
+        "Like the paper (§6.3.3, §7.2: \"generally include all four features\"), the largest feature set the procedure built is kept (ties to the smaller MAE): **{}**, fitted on all {} packings. Cross-validation ({}-fold): MAE = {:.2}×10⁻³, R² = {:.3}. Saved as `models/{}`; apply it with `sedpack predict --model REPORT_FOLDER/models/{}`.",
         equation(model),
         d.len(),
         cv.folds,

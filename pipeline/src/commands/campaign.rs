@@ -60,12 +60,20 @@ fn report(name: &str, summary: Summary, status: &CampaignStatus) {
     }
 }
 
+/// `--checkpoint-interval` as a duration: a positive, finite number of seconds.
+fn checkpoint_interval(seconds: f64) -> anyhow::Result<Duration> {
+    Duration::try_from_secs_f64(seconds)
+        .ok()
+        .filter(|d| !d.is_zero())
+        .ok_or_else(|| anyhow::anyhow!("--checkpoint-interval: expected a positive number of seconds, got {seconds}"))
+}
+
 pub fn run(args: &RunArgs) -> anyhow::Result<()> {
-    let campaign = read_campaign(&args.campaign)?;
     let options = RunOptions {
         workers: workers(args.workers)?,
-        checkpoint_interval: Duration::from_secs_f64(args.checkpoint_interval),
+        checkpoint_interval: checkpoint_interval(args.checkpoint_interval)?,
     };
+    let campaign = read_campaign(&args.campaign)?;
     let log = start_log(&args.db)?;
     runtime()?.block_on(async {
         let store = Store::open(&args.db).await?;
@@ -101,7 +109,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
 pub fn resume(args: &ResumeArgs) -> anyhow::Result<()> {
     let options = RunOptions {
         workers: workers(args.workers)?,
-        checkpoint_interval: Duration::from_secs_f64(args.checkpoint_interval),
+        checkpoint_interval: checkpoint_interval(args.checkpoint_interval)?,
     };
     runtime()?.block_on(async {
         let store = open_existing(&args.db).await?;

@@ -17,7 +17,7 @@ pub fn tangential_stiffness_ratio(poisson_ratio: f64) -> f64 {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub enum Calibration {
     /// Eq. 11 as printed: exact for the continuous equation of motion. Integrated with the
-    /// semi-implicit Euler scheme at T_c/Δt = 40 a collision rebounds with e ≈ 0.087, not 0.1.
+    /// semi-implicit Euler scheme at T_c/Δt = 40 collisions rebound with e ≈ 0.084–0.095, not 0.1.
     Continuous,
     /// Eq. 11 solved for the semi-implicit Euler map of step Δt instead of the continuous motion,
     /// so that a simulated binary collision rebounds with exactly e_n after exactly T_c.

@@ -194,7 +194,7 @@ impl Shape {
         pose: Option<&'a EllipsoidPose>,
     ) -> Piece<'a> {
         match (self, pose) {
-            (Shape::Sphere { radius }, _) => Piece::Sphere { center: position, radius: *radius },
+            (Shape::Sphere { .. }, _) => unreachable!("spheres are handled inline by `piece`"),
             (Shape::Ellipsoid { .. }, Some(pose)) => Piece::Ellipsoid { pose, center: position },
             (Shape::Ellipsoid { .. }, None) => unreachable!("an ellipsoid body always has a pose"),
             (Shape::Bonded(b), _) => {

@@ -13,14 +13,16 @@ use super::mesh::{MeshDefect, TriMesh};
 pub const DEFAULT_MAX_FACES: usize = 300;
 
 /// The Rhine form distribution (Table 2, Fig. 2): pebbles get realistic own forms.
-const RHINE: FormDistribution = FormDistribution { mu_fl: 0.647, sigma_fl: 0.175, mu_el: 0.682, sigma_el: 0.139 };
+/// The form distribution of the Rhine gravel of Table 2 (μ_FL, σ_FL, μ_EL, σ_EL).
+pub const RHINE_FORMS: FormDistribution =
+    FormDistribution { mu_fl: 0.647, sigma_fl: 0.175, mu_el: 0.682, sigma_el: 0.139 };
 
 /// One pebble. A hull of n points in general position has at most 2n − 4 triangles, so
 /// n = (max_faces + 4)/2 points keep the face count within the bound.
 pub fn pebble(seed: u64, max_faces: usize) -> Result<TriMesh, MeshDefect> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let points = (max_faces.max(8) + 4) / 2;
-    let (fl, el) = RHINE.sampler().sample_flatness_elongation(&mut rng);
+    let (fl, el) = RHINE_FORMS.sampler().sample_flatness_elongation(&mut rng);
     let semi_axes = Vector3::new(1.0, el, el * fl);
 
     // Smooth lumps: a few broad bumps and dents of the radius.

@@ -9,7 +9,8 @@ use nalgebra::Vector3;
 /// Geometry of one contact, the same for both bodies of the pair.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactGeometry {
-    /// Contact point, midway between the two bodies' deepest points (world frame).
+    /// Contact point (world frame): midway between the two bodies' deepest points, or for two
+    /// polyhedra the centre of their overlap (the centre of pressure).
     pub point: Vector3<f64>,
     /// Unit contact normal pointing from body A into body B.
     pub normal: Vector3<f64>,
