@@ -170,12 +170,12 @@ fn particle_steps(c: &mut Criterion) {
     ];
     let mut group = c.benchmark_group("settled_bed");
     group.sample_size(10);
-    // About 2,000 ellipsoids (mean grain mass 0.66 g) and 500 grains of the costlier shapes,
-    // whose beds take long to build (bonded grains are lighter: 0.45 g).
+    // About 2,000 ellipsoids (mean grain mass 0.66 g), 500 bonded grains (lighter: 0.45 g) and
+    // 300 polyhedra, whose bed takes longest to build.
     let protocol = [
         ("ellipsoids-2000", ShapeKind::Ellipsoid, 0.06, 1.32),
-        ("polyhedra-500", ShapeKind::Mesh, 0.036, 0.33),
         ("bonded-500", ShapeKind::BondedSpheres, 0.036, 0.225),
+        ("polyhedra-300", ShapeKind::Mesh, 0.036, 0.2),
     ];
     let spheres = beds.iter().map(|bed| (bed.name.to_string(), settled(bed)));
     let others = protocol.iter().flat_map(|&(n, shape, w, m)| {
