@@ -4,6 +4,9 @@
 //! ratios up to 10:1, random orientations): criterion's time is per 1024 queries, its
 //! throughput in queries per second. The Newton iteration counts of each set go to stderr.
 
+mod common;
+use common::random_unit;
+
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
@@ -19,19 +22,6 @@ type V3 = Vector3<f64>;
 
 const PAIRS: usize = 1024;
 
-fn random_rotation(rng: &mut ChaCha8Rng) -> UnitQuaternion<f64> {
-    uniform_rotation(rng)
-}
-
-fn random_unit(rng: &mut ChaCha8Rng) -> V3 {
-    loop {
-        let v = V3::from_fn(|_, _| rng.random_range(-1.0..1.0));
-        if (0.01..1.0).contains(&v.norm()) {
-            return v.normalize();
-        }
-    }
-}
-
 #[derive(Clone, Copy)]
 struct Grain {
     q: UnitQuaternion<f64>,
@@ -40,7 +30,7 @@ struct Grain {
 
 impl Grain {
     fn random(rng: &mut ChaCha8Rng) -> Self {
-        Self { q: random_rotation(rng), axes: V3::from_fn(|_, _| 10f64.powf(rng.random_range(0.0..1.0))) }
+        Self { q: uniform_rotation(rng), axes: V3::from_fn(|_, _| 10f64.powf(rng.random_range(0.0..1.0))) }
     }
 
     fn rotation(&self) -> Matrix3<f64> {

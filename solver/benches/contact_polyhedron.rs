@@ -9,6 +9,9 @@
 //! passed in; "cold" has no previous normal. Criterion's time is per 1024 queries, its
 //! throughput in queries per second. Mean GJK and EPA iterations go to stderr.
 
+mod common;
+use common::random_unit;
+
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
@@ -27,19 +30,6 @@ type V3 = Vector3<f64>;
 
 const PAIRS: usize = 1024;
 const SHAPES: usize = 16;
-
-fn random_rotation(rng: &mut ChaCha8Rng) -> UnitQuaternion<f64> {
-    uniform_rotation(rng)
-}
-
-fn random_unit(rng: &mut ChaCha8Rng) -> V3 {
-    loop {
-        let v = V3::from_fn(|_, _| rng.random_range(-1.0..1.0));
-        if (0.01..1.0).contains(&v.norm()) {
-            return v.normalize();
-        }
-    }
-}
 
 struct Grains {
     shapes: Vec<ConvexPolyhedron>,
@@ -99,7 +89,7 @@ fn pairs(g: &Grains) -> Vec<Pair> {
     let mut out = Vec::with_capacity(PAIRS);
     while out.len() < PAIRS {
         let (a, b) = (rng.random_range(0..SHAPES), rng.random_range(0..SHAPES));
-        let (qa, qb) = (random_rotation(&mut rng), random_rotation(&mut rng));
+        let (qa, qb) = (uniform_rotation(&mut rng), uniform_rotation(&mut rng));
         let m = random_unit(&mut rng);
         let size = g.shapes[a].bounding_radius() + g.shapes[b].bounding_radius();
         let mut pair = Pair { a, b, qa, qb, xb: V3::zeros(), previous_normal: V3::zeros() };
@@ -192,7 +182,7 @@ fn floor_and_poses(c: &mut Criterion) {
     let grains: Vec<(usize, Matrix3<f64>, V3)> = (0..PAIRS)
         .map(|_| {
             let k = rng.random_range(0..SHAPES);
-            let r = random_rotation(&mut rng).to_rotation_matrix().into_inner();
+            let r = uniform_rotation(&mut rng).to_rotation_matrix().into_inner();
             let lowest = g.shapes[k].vertices().iter().map(|v| (r * v).z).fold(f64::INFINITY, f64::min);
             (k, r, V3::new(0.0, 0.0, -lowest - 1e-3 * g.shapes[k].bounding_radius()))
         })

@@ -320,19 +320,8 @@ impl Pair<'_> {
     fn solve(&self, warm: Option<&Vector3<f64>>, stats: &mut SolveStats) -> Option<End> {
         let mut best: Option<End> = None;
         for start in [warm.and_then(unit), unit(&self.d)].into_iter().flatten() {
-            match self.descend(start, stats) {
-                Descent::Separated(n) => {
-                    stats.certified = true;
-                    stats.separating = Some(n);
-                    return None;
-                }
-                Descent::Stopped { end, converged } => {
-                    if converged && end.f < self.rolling_radius {
-                        stats.certified = true;
-                        return Some(end);
-                    }
-                    keep_lower(&mut best, end);
-                }
+            if let Some(answer) = self.conclude(self.descend(start, stats), stats, &mut best) {
+                return answer;
             }
         }
         stats.global_search = true;
@@ -355,22 +344,31 @@ impl Pair<'_> {
             }
         }
         for start in &candidates.n[..candidates.len] {
-            match self.descend(*start, stats) {
-                Descent::Separated(n) => {
-                    stats.certified = true;
-                    stats.separating = Some(n);
-                    return None;
-                }
-                Descent::Stopped { end, converged } => {
-                    if converged && end.f < self.rolling_radius {
-                        stats.certified = true;
-                        return Some(end);
-                    }
-                    keep_lower(&mut best, end);
-                }
+            if let Some(answer) = self.conclude(self.descend(*start, stats), stats, &mut best) {
+                return answer;
             }
         }
         best
+    }
+
+    /// What one descent settles: `Some(answer)` when it certifies the answer (separated, or a
+    /// converged minimum below the rolling radius), else `None` after keeping the lower end.
+    fn conclude(&self, descent: Descent, stats: &mut SolveStats, best: &mut Option<End>) -> Option<Option<End>> {
+        match descent {
+            Descent::Separated(n) => {
+                stats.certified = true;
+                stats.separating = Some(n);
+                Some(None)
+            }
+            Descent::Stopped { end, converged } => {
+                if converged && end.f < self.rolling_radius {
+                    stats.certified = true;
+                    return Some(Some(end));
+                }
+                keep_lower(best, end);
+                None
+            }
+        }
     }
 
     /// Riemannian Newton on the unit sphere from `start`, with a backtracking line search.
