@@ -14,4 +14,4 @@ pub use contact::ContactGeometry;
 pub use contact_law::{Calibration, ContactHistory, LinearSpringDashpot};
 pub use domain::Domain;
 pub use shape::Shape;
-pub use simulation::{Audit, MIN_STEPS_PER_COLLISION, Settings, Shaking, Simulation};
+pub use simulation::{Audit, MIN_STEPS_PER_COLLISION, Memory, Settings, Shaking, Simulation, StageTimes};

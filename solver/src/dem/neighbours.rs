@@ -167,6 +167,25 @@ impl NeighbourList {
         })
     }
 
+    /// Bytes held per body: reference positions and orientations, wraps and the pair index.
+    pub fn body_bytes(&self) -> usize {
+        use std::mem::size_of_val;
+        size_of_val(&self.reference[..])
+            + size_of_val(&self.reference_orientation[..])
+            + size_of_val(&self.wraps[..])
+            + size_of_val(&self.offsets[..])
+            + size_of_val(&self.split[..])
+    }
+
+    /// Bytes held per listed pair: the pair, its history and cache, and its two index entries.
+    pub fn pair_bytes(&self) -> usize {
+        use std::mem::size_of_val;
+        size_of_val(&self.pairs[..])
+            + size_of_val(&self.history[..])
+            + size_of_val(&self.cache[..])
+            + size_of_val(&self.entries[..])
+    }
+
     /// Pairs of body `b`: those where it is i, and those where it is j.
     #[inline]
     pub fn pairs_of(&self, b: usize) -> (&[u32], &[u32]) {

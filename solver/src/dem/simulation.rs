@@ -106,6 +106,36 @@ impl Audit {
     }
 }
 
+/// Wall contact points a body keeps at most; a bonded grain lying flat on the floor touches it
+/// with many spheres.
+const MAX_WALL_POINTS: usize = 64;
+
+/// What a body keeps of one point of its contact with a wall.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct WallPoint {
+    /// The wall and the body's piece, and the key of the manifold point (its vertex or edge).
+    pub key: (u32, u64),
+    pub history: ContactHistory,
+}
+
+impl WallPoint {
+    fn key(wall: u32, piece: usize, feature: u64) -> (u32, u64) {
+        (wall << 16 | piece as u32, feature)
+    }
+}
+
+/// Memory held by a simulation ([`Simulation::memory`]), in bytes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Memory {
+    /// Everything kept per body: its state, shape, wall histories, pose and neighbour index.
+    pub bodies: usize,
+    /// Everything kept per listed pair: the pair, its contact history, narrow-phase cache and
+    /// force.
+    pub pairs: usize,
+    /// The base meshes of polyhedron grains, each counted once however many grains share it.
+    pub shared_meshes: usize,
+}
+
 /// Wall-clock time spent in each stage since the simulation began.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct StageTimes {
@@ -121,9 +151,8 @@ pub struct Simulation {
     pub settings: Settings,
     law: LinearSpringDashpot,
     neighbours: NeighbourList,
-    /// Per body, the history of each piece's contact with the floor and with the cylinder wall.
-    floor_history: Vec<Vec<ContactHistory>>,
-    wall_history: Vec<Vec<ContactHistory>>,
+    /// Per body, the points of its open contacts with the floor and the cylinder wall.
+    walls: Vec<Vec<WallPoint>>,
     pub time: f64,
     pub steps: u64,
     /// Shaking force applied in the current phase, if any.
@@ -132,6 +161,9 @@ pub struct Simulation {
     pub damping: Option<f64>,
     /// Contacts (pair and wall) open in the last step.
     pub contacts: usize,
+    /// Of those, the contacts between pieces of two bodies.
+    #[serde(default)]
+    pub pair_contacts: usize,
     #[serde(skip)]
     pipeline: Pipeline,
 }
@@ -168,13 +200,13 @@ impl Simulation {
                 settings.calibration,
             ),
             neighbours: NeighbourList::new(settings.skin),
-            floor_history: Vec::new(),
-            wall_history: Vec::new(),
+            walls: Vec::new(),
             time: 0.0,
             steps: 0,
             shaking: None,
             damping: None,
             contacts: 0,
+            pair_contacts: 0,
             pipeline: Pipeline::default(),
         })
     }
@@ -195,8 +227,7 @@ impl Simulation {
     }
 
     pub fn add_body(&mut self, body: NewBody) -> usize {
-        self.floor_history.push(vec![ContactHistory::default(); body.shape.pieces()]);
-        self.wall_history.push(vec![ContactHistory::default(); body.shape.pieces()]);
+        self.walls.push(Vec::new());
         self.bodies.push(body, self.settings.density)
     }
 
@@ -219,6 +250,7 @@ impl Simulation {
             return Err(SolverError::NotFinite { time: self.time });
         }
         self.contacts = pair_contacts + wall_contacts;
+        self.pair_contacts = pair_contacts;
         self.time += self.settings.time_step;
         self.steps += 1;
         let times = &mut self.pipeline.stage_times;
@@ -358,12 +390,11 @@ impl Simulation {
             b.velocity.par_iter_mut(),
             b.angular_velocity.par_iter_mut(),
             b.travel.par_iter_mut(),
-            self.floor_history.par_iter_mut(),
-            self.wall_history.par_iter_mut(),
+            self.walls.par_iter_mut(),
         )
             .into_par_iter()
             .enumerate()
-            .map(|(k, (x, q, v, w, travel, floor, wall))| {
+            .map(|(k, (x, q, v, w, travel, walls))| {
                 let shape = &b.shape[k];
                 let pose = &poses[k];
                 let mass = b.mass[k];
@@ -380,25 +411,37 @@ impl Simulation {
                     force += pf.force;
                     torque += pf.torque_j;
                 }
-                let mut wall_contacts = 0;
-                for (k, (floor, wall)) in floor.iter_mut().zip(wall.iter_mut()).enumerate() {
-                    let piece = shape.piece(k, *x, q, pose);
-                    for (geometry, history) in
-                        [(contact::with_floor(&piece), &mut *floor), (contact::with_wall(&piece, &domain), &mut *wall)]
+                // Each wall contact is one point or a face's manifold; every point keeps its
+                // tangential history under its key (wall, piece, vertex) while it stays open.
+                let mut open = [WallPoint::default(); MAX_WALL_POINTS];
+                let mut n_open = 0;
+                for piece in 0..shape.pieces() {
+                    let p = shape.piece(piece, *x, q, pose);
+                    for (wall, manifold) in
+                        [(0, contact::with_floor_manifold(&p)), (1, contact::with_wall_manifold(&p, &domain))]
                     {
-                        let Some(g) = geometry else {
-                            *history = ContactHistory::default();
-                            continue;
-                        };
-                        // The wall is body B, immovable: m_eff = m and its velocity is zero.
-                        let arm = g.point - *x;
-                        let relative = -(*v + w.cross(&arm));
-                        let f = -law.force(mass, &g, &relative, history, dt);
-                        force += f;
-                        torque += arm.cross(&f);
-                        wall_contacts += 1;
+                        let Some(m) = manifold else { continue };
+                        for j in 0..m.len {
+                            let key = WallPoint::key(wall, piece, m.features[j]);
+                            let mut history =
+                                walls.iter().find(|e| e.key == key).map_or_else(ContactHistory::default, |e| e.history);
+                            let g = m.point(j);
+                            // The wall is body B, immovable: m_eff = m and its velocity is zero.
+                            let arm = g.point - *x;
+                            let relative = -(*v + w.cross(&arm));
+                            let f = -law.force(mass * m.weights[j], &g, &relative, &mut history, dt);
+                            force += f;
+                            torque += arm.cross(&f);
+                            if n_open < MAX_WALL_POINTS {
+                                open[n_open] = WallPoint { key, history };
+                                n_open += 1;
+                            }
+                        }
                     }
                 }
+                let wall_contacts = n_open;
+                walls.clear();
+                walls.extend_from_slice(&open[..n_open]);
 
                 *v += force * (dt / mass);
                 let inertia = b.inertia[k];
@@ -428,6 +471,40 @@ impl Simulation {
                 (wall_contacts, (x.sum() + v.sum() + w.sum()).is_finite())
             })
             .reduce(|| (0, true), |a, b| (a.0 + b.0, a.1 && b.1))
+    }
+
+    /// Bytes of memory the simulation holds: per body and per listed pair (state and the step's
+    /// working memory), and the base meshes that polyhedron grains share.
+    pub fn memory(&self) -> Memory {
+        use std::mem::size_of_val;
+        let b = &self.bodies;
+        let arrays = size_of_val(&b.position[..])
+            + size_of_val(&b.orientation[..])
+            + size_of_val(&b.velocity[..])
+            + size_of_val(&b.angular_velocity[..])
+            + size_of_val(&b.mass[..])
+            + size_of_val(&b.inertia[..])
+            + size_of_val(&b.volume[..])
+            + size_of_val(&b.shape[..])
+            + size_of_val(&b.bounding_radius[..])
+            + size_of_val(&b.travel[..]);
+        let shapes: usize = b.shape.iter().map(Shape::heap_bytes).sum();
+        let walls: usize =
+            self.walls.iter().map(|h| size_of_val(h) + h.capacity() * std::mem::size_of::<WallPoint>()).sum();
+        let mut meshes: Vec<&std::sync::Arc<super::shape::ConvexPolyhedron>> = Vec::new();
+        for shape in &b.shape {
+            if let Shape::Polyhedron(p) = shape
+                && !meshes.iter().any(|m| std::sync::Arc::ptr_eq(m, &p.base))
+            {
+                meshes.push(&p.base);
+            }
+        }
+        let pipeline = &self.pipeline;
+        Memory {
+            bodies: arrays + shapes + walls + self.neighbours.body_bytes() + size_of_val(&pipeline.poses[..]),
+            pairs: self.neighbours.pair_bytes() + size_of_val(&pipeline.pair_forces[..]),
+            shared_meshes: meshes.iter().map(|m| m.heap_bytes()).sum(),
+        }
     }
 
     /// Mass-averaged height ⟨z⟩ = Σ m z / Σ m (§4.3).

@@ -9,6 +9,7 @@ pub mod coherence;
 pub mod ellipsoid;
 pub(crate) mod epa;
 pub(crate) mod gjk;
+pub mod manifold;
 pub mod polyhedron;
 pub mod sphere;
 pub mod support;
@@ -17,6 +18,7 @@ use nalgebra::{Matrix3, Vector3};
 
 pub use self::coherence::PairCache;
 use self::ellipsoid::EllipsoidPose;
+pub use self::manifold::Manifold;
 use self::polyhedron::Apart;
 pub use self::polyhedron::Mode;
 use self::support::PolyhedronPose;
@@ -153,6 +155,28 @@ fn curved(
         }
     }
     contact
+}
+
+/// Contact of a piece with the floor z = 0, as a manifold: a polyhedron's face lying on the
+/// floor spreads over its corners, every other contact is one point.
+#[inline]
+pub fn with_floor_manifold(p: &Piece) -> Option<Manifold> {
+    match p {
+        Piece::Polyhedron(pose) => polyhedron::polyhedron_plane_manifold(pose, &Vector3::zeros(), &Vector3::z()),
+        _ => with_floor(p).map(Manifold::single),
+    }
+}
+
+/// Contact of a piece with the cylinder wall, if the domain has one, as a manifold.
+#[inline]
+pub fn with_wall_manifold(p: &Piece, domain: &Domain) -> Option<Manifold> {
+    match (p, domain) {
+        (Piece::Polyhedron(pose), Domain::Cylinder { diameter }) => {
+            let c = diameter / 2.0;
+            polyhedron::polyhedron_cylinder_wall_manifold(pose, c, c, c)
+        }
+        _ => with_wall(p, domain).map(Manifold::single),
+    }
 }
 
 /// Contact of a piece with the floor z = 0.

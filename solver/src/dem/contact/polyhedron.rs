@@ -41,6 +41,7 @@ use super::coherence::{Features, Order};
 use super::ellipsoid::{EllipsoidPose, tangent_basis, unit};
 use super::epa::{self, Penetration};
 use super::gjk::{self, Distance};
+use super::manifold::{self, Manifold};
 pub use super::support::PolyhedronPose;
 use super::support::{Centre, Convex, Cso, Point};
 
@@ -513,6 +514,93 @@ fn penetration<A: Convex, B: Convex>(a: &A, b: &B, warm_normal: Option<&V3>, gap
     let end = gjk::complete(&mut cso, simplex, tiny)
         .and_then(|s| epa::expand(&mut cso, &s.p, gap * reach, VISIBLE * reach, tiny, &mut iterations));
     end.filter(|e| e.depth > 0.0).ok_or_else(Apart::default)
+}
+
+/// [`polyhedron_plane`] as a manifold ([`super::manifold`]): a face lying on the plane spreads
+/// the contact over its corners.
+pub fn polyhedron_plane_manifold(a: &PolyhedronPose, plane_point: &V3, plane_normal: &V3) -> Option<Manifold> {
+    let n = -plane_normal;
+    let level = n.dot(&(plane_point - a.center()));
+    if level >= a.bounding_radius() {
+        return None;
+    }
+    let mut deepest = a.cold_hint(&n);
+    let top = n.dot(&a.reach(&n, &mut deepest));
+    let depth = top - level;
+    (depth > 0.0).then(|| manifold_beyond(a, &n, level, deepest, depth))
+}
+
+/// [`polyhedron_cylinder_wall`] as a manifold on the wall's tangent plane.
+pub fn polyhedron_cylinder_wall_manifold(
+    a: &PolyhedronPose,
+    axis_x: f64,
+    axis_y: f64,
+    radius: f64,
+) -> Option<Manifold> {
+    let c = polyhedron_cylinder_wall(a, axis_x, axis_y, radius)?;
+    let offset = V2::new(a.center().x - axis_x, a.center().y - axis_y);
+    let level = radius - offset.dot(&c.normal.xy());
+    let mut deepest = a.cold_hint(&c.normal);
+    a.reach(&c.normal, &mut deepest);
+    Some(manifold_beyond(a, &c.normal, level, deepest, c.depth))
+}
+
+/// The manifold of A entering the half-space {n·(x − x_A) ≥ level} by `depth`. The footprint
+/// is the projection of A's part beyond the plane: the hull of its vertices beyond (walked from
+/// `deepest`; they are connected) and of the points where its edges leaving them cross the plane,
+/// keyed by vertex and by edge. A crossing within 1e-3 of the grain's size of an end of its edge
+/// is that vertex: a face lying flat has its side edges cross the plane right at its corners, and
+/// a corner just lifting off stays one point.
+fn manifold_beyond(a: &PolyhedronPose, n: &V3, level: f64, deepest: u32, depth: f64) -> Manifold {
+    let geometry = plane_contact(a, n, level, deepest, depth);
+    let shape = a.shape();
+    let hair = 1e-3 * a.bounding_radius();
+    let mut beyond = [0u32; 64];
+    let mut corners = [(V3::zeros(), 0u64); 64];
+    beyond[0] = deepest;
+    corners[0] = (a.center() + a.vertex(deepest), u64::from(deepest));
+    let (mut n_beyond, mut len, mut next) = (1, 1, 0);
+    while next < n_beyond {
+        let v = beyond[next];
+        next += 1;
+        let x = a.vertex(v);
+        let hv = n.dot(&x) - level;
+        for &w in shape.neighbours_of(v) {
+            let y = a.vertex(w);
+            let hw = n.dot(&y) - level;
+            if hw > 0.0 {
+                if !beyond[..n_beyond].contains(&w) {
+                    if n_beyond == beyond.len() || len == corners.len() {
+                        return Manifold::single(geometry);
+                    }
+                    beyond[n_beyond] = w;
+                    corners[len] = (a.center() + y, u64::from(w));
+                    n_beyond += 1;
+                    len += 1;
+                }
+            } else {
+                let crossing = x + (y - x) * (hv / (hv - hw));
+                // Near either end the crossing is that vertex (a corner just lifting off keeps
+                // its key, and with it its history).
+                let (point, key) = if (crossing - x).norm() <= hair {
+                    continue;
+                } else if (crossing - y).norm() <= hair {
+                    (y, u64::from(w))
+                } else {
+                    (crossing, manifold::edge_key(v, w))
+                };
+                if corners[..len].iter().any(|c| c.1 == key) {
+                    continue;
+                }
+                if len == corners.len() {
+                    return Manifold::single(geometry);
+                }
+                corners[len] = (a.center() + point, key);
+                len += 1;
+            }
+        }
+    }
+    Manifold::spread(geometry, &corners[..len])
 }
 
 /// Contact with the half-space {n·(x − x_A) ≥ level} that A enters by `depth`, its vertex

@@ -105,6 +105,15 @@ impl Shape {
         }
     }
 
+    /// Bytes the shape holds outside its own enum (a polyhedron's shared base mesh excluded).
+    pub fn heap_bytes(&self) -> usize {
+        match self {
+            Shape::Sphere { .. } | Shape::Ellipsoid { .. } => 0,
+            Shape::Bonded(b) => std::mem::size_of::<Bonded>() + std::mem::size_of_val(&b.spheres[..]),
+            Shape::Polyhedron(_) => std::mem::size_of::<Polyhedron>(),
+        }
+    }
+
     /// Number of convex pieces the narrow phase meets.
     #[inline]
     pub fn pieces(&self) -> usize {

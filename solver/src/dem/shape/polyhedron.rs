@@ -188,6 +188,19 @@ impl ConvexPolyhedron {
         self.bounding_radius
     }
 
+    /// Bytes of its vertex, adjacency and face tables.
+    pub fn heap_bytes(&self) -> usize {
+        use std::mem::size_of_val;
+        size_of_val(&self.vertices[..])
+            + size_of_val(&self.neighbour_start[..])
+            + size_of_val(&self.neighbours[..])
+            + size_of_val(&self.triangles[..])
+            + size_of_val(&self.normals[..])
+            + size_of_val(&self.incident_start[..])
+            + size_of_val(&self.incident[..])
+            + std::mem::size_of::<Self>()
+    }
+
     /// Volume, centre of mass and inertia (per unit density) of the solid.
     pub fn mass_properties(&self) -> &MassProperties {
         &self.mass
