@@ -18,10 +18,12 @@ use parry3d_f64::shape::SupportMap;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use solver::dem::contact::ContactGeometry;
+use solver::dem::contact::centre_of_pressure::Overlap;
+use solver::dem::contact::coherence::Features;
 use solver::dem::contact::ellipsoid::EllipsoidPose;
 use solver::dem::contact::polyhedron::{
-    PolyhedronPose, polyhedron_cylinder_wall, polyhedron_ellipsoid, polyhedron_plane, polyhedron_polyhedron,
-    polyhedron_polyhedron_with_stats, polyhedron_sphere,
+    Mode, PolyhedronPose, polyhedron_cylinder_wall, polyhedron_ellipsoid, polyhedron_plane, polyhedron_polyhedron,
+    polyhedron_polyhedron_coherent, polyhedron_polyhedron_with_stats, polyhedron_sphere,
 };
 use solver::dem::shape::ConvexPolyhedron;
 use solver::dem::uniform_rotation;
@@ -185,7 +187,79 @@ fn overlap_centroid(a: &World, b: &World) -> Option<V3> {
             }
         }
     }
-    Some(TriMesh::convex_hull(&points).ok()?.mass_properties().center_of_mass)
+    hull_centroid(&points)
+}
+
+/// Centroid of the convex hull of `points`, by brute force: every plane through three points
+/// with all the others on one side bounds the hull; the hull of the points on it fans into
+/// triangles, each making a tetrahedron with the points' mean.
+fn hull_centroid(points: &[V3]) -> Option<V3> {
+    let mean = points.iter().sum::<V3>() / points.len() as f64;
+    let scale = points.iter().map(|p| (p - mean).norm()).fold(0.0, f64::max);
+    let tolerance = 1e-10 * scale;
+    let mut faces: Vec<Vec<usize>> = Vec::new();
+    let (mut volume, mut moment) = (0.0, V3::zeros());
+    for i in 0..points.len() {
+        for j in i + 1..points.len() {
+            for k in j + 1..points.len() {
+                let cross = (points[j] - points[i]).cross(&(points[k] - points[i]));
+                if cross.norm() <= tolerance * scale {
+                    continue;
+                }
+                let mut n = cross.normalize();
+                let mut d = n.dot(&points[i]);
+                if points.iter().any(|p| n.dot(p) > d + tolerance) {
+                    if points.iter().any(|p| n.dot(p) < d - tolerance) {
+                        continue;
+                    }
+                    (n, d) = (-n, -d);
+                }
+                // A face is found from every triple of its points: count it once, by its points.
+                let key: Vec<usize> =
+                    (0..points.len()).filter(|&m| (n.dot(&points[m]) - d).abs() <= tolerance).collect();
+                if faces.contains(&key) {
+                    continue;
+                }
+                faces.push(key.clone());
+                // The face: the hull of the points on the plane (others lie inside it).
+                let on: Vec<V3> = key.iter().map(|&m| points[m]).collect();
+                let far = on.iter().max_by(|p, q| (*p - on[0]).norm().total_cmp(&(*q - on[0]).norm())).unwrap();
+                let u = (far - on[0]).normalize();
+                let w = n.cross(&u);
+                let mut flat: Vec<(f64, f64, V3)> = on.iter().map(|p| (p.dot(&u), p.dot(&w), *p)).collect();
+                flat.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.total_cmp(&q.1)));
+                let turn = |o: &(f64, f64, V3), a: &(f64, f64, V3), b: &(f64, f64, V3)| {
+                    (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
+                };
+                let mut chain: Vec<(f64, f64, V3)> = Vec::new();
+                for pass in 0..2 {
+                    let start = chain.len();
+                    let order: Vec<(f64, f64, V3)> =
+                        if pass == 0 { flat.clone() } else { flat.iter().rev().copied().collect() };
+                    for p in order {
+                        while chain.len() >= start + 2
+                            && turn(&chain[chain.len() - 2], &chain[chain.len() - 1], &p) <= tolerance * scale
+                        {
+                            chain.pop();
+                        }
+                        chain.push(p);
+                    }
+                    chain.pop();
+                }
+                let on: Vec<V3> = chain.iter().map(|p| p.2).collect();
+                if on.len() < 3 {
+                    continue;
+                }
+                for m in 1..on.len() - 1 {
+                    let (a, b, c) = (on[0], on[m], on[m + 1]);
+                    let v = (a - mean).dot(&(b - mean).cross(&(c - mean))).abs() / 6.0;
+                    volume += v;
+                    moment += (a + b + c + mean) * (v / 4.0);
+                }
+            }
+        }
+    }
+    (volume > 0.0).then(|| moment / volume)
 }
 
 fn parry_pose(pose: &PolyhedronPose) -> Pose {
@@ -805,4 +879,72 @@ fn polyhedron_ellipsoid_matches_sphere_and_parry() {
     assert!(worst_sphere.iter().all(|&w| w < 1e-12), "{worst_sphere:?}");
     assert!(worst_certificate < 1e-12 && parry_deeper < 1e-12);
     assert!(worst_depth < 1e-9 && worst_normal < 1e-4);
+}
+
+#[test]
+fn the_engines_shortcuts_on_persisting_contacts_match_independent_references() {
+    // Shallow contacts of random hulls (depth 0.1 % or 1 % of their size, as in a bed), solved
+    // cold by the engine's query, then one time step later (both turned by 1e-4 rad, B moved by
+    // 1e-5) from the features kept: EPA confirmed from the last face, the centre of pressure in
+    // closed form or by clipping the pyramid or tetrahedron. Depth and normal against the
+    // separating-axis theorem, the point against the independently built overlap centroid.
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let (mut warm, mut pyramids, mut tetrahedra, mut clipped, mut compared) = (0, 0, 0, 0, 0);
+    let (mut worst_depth, mut worst_normal, mut worst_point) = (0.0f64, 0.0f64, 0.0f64);
+    for k in 0..600 {
+        let (na, nb) = (rng.random_range(8..60), rng.random_range(8..60));
+        let (sa, sb) = (random_hull(&mut rng, na), random_hull(&mut rng, nb));
+        let (ra, rb) = (random_rotation(&mut rng), random_rotation(&mut rng));
+        let m = random_unit(&mut rng);
+        let size = sa.bounding_radius() + sb.bounding_radius();
+        let a = PolyhedronPose::new(&sa, V3::zeros(), &ra);
+        // B approaches A along m until they touch (bisection), then by the depth further.
+        let (mut inside, mut outside) = (0.0, size);
+        for _ in 0..60 {
+            let t = 0.5 * (inside + outside);
+            if polyhedron_polyhedron(&a, &PolyhedronPose::new(&sb, m * t, &rb), None).is_some() {
+                inside = t;
+            } else {
+                outside = t;
+            }
+        }
+        let depth = if k % 2 == 0 { 1e-3 } else { 1e-2 } * size;
+        let b = PolyhedronPose::new(&sb, m * (outside - depth), &rb);
+        let mut features = Features::default();
+        let Some(first) = polyhedron_polyhedron_coherent(&a, &b, None, &mut features, Mode::Coherent).0 else {
+            continue;
+        };
+        let turn = |r: &Matrix3<f64>, rng: &mut ChaCha8Rng| rotation(random_unit(rng), 1e-4) * r;
+        let (ra2, rb2) = (turn(&ra, &mut rng), turn(&rb, &mut rng));
+        let a2 = PolyhedronPose::new(&sa, V3::zeros(), &ra2);
+        let b2 = PolyhedronPose::new(&sb, b.center() + random_unit(&mut rng) * 1e-5 * size, &rb2);
+        let (c, _, stats) =
+            polyhedron_polyhedron_coherent(&a2, &b2, Some(&first.normal), &mut features, Mode::Coherent);
+        let Some(c) = c else { continue };
+        let (wa, wb) = (World::of(&a2), World::of(&b2));
+        let (sat_depth, sat_normal, second) = sat(&wa, &wb);
+        worst_depth = worst_depth.max((c.depth - sat_depth).abs() / size);
+        if second - sat_depth > 1e-9 {
+            worst_normal = worst_normal.max((c.normal - sat_normal).norm());
+        }
+        warm += usize::from(stats.warm_features);
+        match stats.overlap {
+            Some(Overlap::Pyramid) => pyramids += 1,
+            Some(Overlap::Tetrahedron) => tetrahedra += 1,
+            Some(Overlap::Clipped) => clipped += 1,
+            _ => {}
+        }
+        if let Some(centroid) = overlap_centroid(&wa, &wb) {
+            let tangential = |x: V3| x - c.normal * c.normal.dot(&x);
+            let e = (tangential(c.point) - tangential(centroid)).norm() / size;
+            worst_point = worst_point.max(e);
+            compared += 1;
+        }
+    }
+    eprintln!(
+        "{compared} contacts, {warm} from kept features; {pyramids} pyramids, {tetrahedra} tetrahedra, {clipped} clipped: worst depth {worst_depth:e}, normal {worst_normal:e}, point {worst_point:e}"
+    );
+    assert!(compared > 500 && warm * 10 > compared * 8, "{warm} of {compared} from kept features");
+    assert!(pyramids > 50 && tetrahedra > 50, "{pyramids} pyramids, {tetrahedra} tetrahedra");
+    assert!(worst_depth < 1e-13 && worst_normal < 1e-9 && worst_point < 1e-9);
 }

@@ -86,10 +86,12 @@ pub struct Audit {
     pub contacts: usize,
     pub mismatched: usize,
     /// Largest differences in depth and point relative to the pair's size (the sum of the
-    /// pieces' bounding radii), and in the normal's direction (radians).
+    /// pieces' bounding radii), and between the unit normals.
     pub depth: f64,
     pub point: f64,
     pub normal: f64,
+    /// Contacts whose points differ by more than 1e-9 of the pair's size.
+    pub points_beyond: usize,
 }
 
 impl Audit {
@@ -100,15 +102,12 @@ impl Audit {
         self.wrongly_skipped += other.wrongly_skipped;
         self.contacts += other.contacts;
         self.mismatched += other.mismatched;
+        self.points_beyond += other.points_beyond;
         self.depth = self.depth.max(other.depth);
         self.point = self.point.max(other.point);
         self.normal = self.normal.max(other.normal);
     }
 }
-
-/// Wall contact points a body keeps at most; a bonded grain lying flat on the floor touches it
-/// with many spheres.
-const MAX_WALL_POINTS: usize = 64;
 
 /// What a body keeps of one point of its contact with a wall.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
@@ -116,6 +115,9 @@ pub struct WallPoint {
     /// The wall and the body's piece, and the key of the manifold point (its vertex or edge).
     pub key: (u32, u64),
     pub history: ContactHistory,
+    /// Found open in the current step (points no longer open are dropped at its end).
+    #[serde(skip)]
+    open: bool,
 }
 
 impl WallPoint {
@@ -293,9 +295,11 @@ impl Simulation {
             match (full, fast) {
                 (Some(f), Some(c)) => {
                     audit.contacts += 1;
+                    let point = (f.point - c.point).norm() / size;
                     audit.depth = audit.depth.max((f.depth - c.depth).abs() / size);
-                    audit.point = audit.point.max((f.point - c.point).norm() / size);
-                    audit.normal = audit.normal.max(f.normal.angle(&c.normal));
+                    audit.point = audit.point.max(point);
+                    audit.points_beyond += usize::from(point > 1e-9);
+                    audit.normal = audit.normal.max((f.normal - c.normal).norm());
                 }
                 (None, None) => {}
                 _ => audit.mismatched += 1,
@@ -413,8 +417,9 @@ impl Simulation {
                 }
                 // Each wall contact is one point or a face's manifold; every point keeps its
                 // tangential history under its key (wall, piece, vertex) while it stays open.
-                let mut open = [WallPoint::default(); MAX_WALL_POINTS];
-                let mut n_open = 0;
+                for e in walls.iter_mut() {
+                    e.open = false;
+                }
                 for piece in 0..shape.pieces() {
                     let p = shape.piece(piece, *x, q, pose);
                     for (wall, manifold) in
@@ -423,25 +428,26 @@ impl Simulation {
                         let Some(m) = manifold else { continue };
                         for j in 0..m.len {
                             let key = WallPoint::key(wall, piece, m.features[j]);
-                            let mut history =
-                                walls.iter().find(|e| e.key == key).map_or_else(ContactHistory::default, |e| e.history);
+                            let entry = match walls.iter().position(|e| e.key == key) {
+                                Some(found) => &mut walls[found],
+                                None => {
+                                    walls.push(WallPoint { key, history: ContactHistory::default(), open: false });
+                                    walls.last_mut().expect("just pushed")
+                                }
+                            };
+                            entry.open = true;
                             let g = m.point(j);
                             // The wall is body B, immovable: m_eff = m and its velocity is zero.
                             let arm = g.point - *x;
                             let relative = -(*v + w.cross(&arm));
-                            let f = -law.force(mass * m.weights[j], &g, &relative, &mut history, dt);
+                            let f = -law.force(mass * m.weights[j], &g, &relative, &mut entry.history, dt);
                             force += f;
                             torque += arm.cross(&f);
-                            if n_open < MAX_WALL_POINTS {
-                                open[n_open] = WallPoint { key, history };
-                                n_open += 1;
-                            }
                         }
                     }
                 }
-                let wall_contacts = n_open;
-                walls.clear();
-                walls.extend_from_slice(&open[..n_open]);
+                walls.retain(|e| e.open);
+                let wall_contacts = walls.len();
 
                 *v += force * (dt / mass);
                 let inertia = b.inertia[k];
