@@ -1,28 +1,15 @@
 //! End-to-end tests of campaigns: `sedpack run`, `resume`, `status`, `export` and `report` on
 //! small real packings, including kill -9 in the middle of a job.
 
+mod common;
+
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
+use common::{fails, json, ok, write};
 use serde_json::Value;
 use store::{ExportRow, JobState, Store};
-
-fn sedpack(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sedpack")).args(args).output().expect("sedpack runs")
-}
-
-fn ok(args: &[&str]) -> String {
-    let out = sedpack(args);
-    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
-    String::from_utf8(out.stdout).unwrap()
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> String {
-    let path = dir.join(name);
-    std::fs::write(&path, text).unwrap();
-    path.to_str().unwrap().to_string()
-}
 
 /// A 2 × 2 grid of sphere packings of ~60 grains; `shaking` sets how long each runs.
 fn campaign(name: &str, shaking: f64) -> String {
@@ -65,7 +52,7 @@ fn a_grid_campaign_runs_once_and_reports() {
     let db = db.to_str().unwrap();
     let first = ok(&["run", &file, "--db", db, "--workers", "2", "--quiet"]);
     assert!(first.contains("4 job(s), 4 new"), "{first}");
-    let status: Value = serde_json::from_str(&ok(&["status", "grid", "--db", db, "--json"])).unwrap();
+    let status = json(&["status", "grid", "--db", db, "--json"]);
     assert_eq!(
         (status["jobs"].as_u64(), status["done"].as_u64(), status["pending"].as_u64()),
         (Some(4), Some(4), Some(0))
@@ -293,7 +280,7 @@ fn failing_jobs_are_recorded_and_retried_on_request() {
     let out = ok(&["run", &file, "--db", db, "--quiet"]);
     assert!(out.contains("1 job(s) finished now, 1 failed now"), "{out}");
     assert!(out.contains("not converged"), "the failure is shown with its error: {out}");
-    let status: Value = serde_json::from_str(&ok(&["status", "failing", "--db", db, "--json"])).unwrap();
+    let status = json(&["status", "failing", "--db", db, "--json"]);
     assert_eq!(status["failed"], 1);
     assert!(status["failures"][0]["error"].as_str().unwrap().contains("solver.max_time = 0.02"));
     let retried = ok(&["run", &file, "--db", db, "--retry-failed", "--quiet"]);
@@ -303,14 +290,6 @@ fn failing_jobs_are_recorded_and_retried_on_request() {
 #[test]
 fn bad_campaigns_and_databases_are_refused_clearly() {
     let dir = tempfile::tempdir().unwrap();
-    let fails = |args: &[&str], needles: &[&str]| {
-        let out = sedpack(args);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
-        for n in needles {
-            assert!(stderr.contains(n), "'{stderr}' lacks '{n}'");
-        }
-    };
     let db = dir.path().join("x.db");
     let db = db.to_str().unwrap();
     let empty = write(dir.path(), "empty.yaml", "name: e\ngrid:\n  material.friction: []\n");

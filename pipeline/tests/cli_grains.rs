@@ -1,33 +1,9 @@
 //! End-to-end tests of `sedpack forms`, `sample` and `predict`, running the built binary.
 
-use std::process::{Command, Output};
+mod common;
 
+use common::{fails, json, repo, sedpack};
 use serde_json::Value;
-
-fn sedpack(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sedpack")).args(args).output().expect("sedpack runs")
-}
-
-fn json(args: &[&str]) -> Value {
-    let out = sedpack(args);
-    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
-    serde_json::from_slice(&out.stdout).expect("one JSON object")
-}
-
-/// The command fails with exit code 1 and one line on stderr containing every `needle`.
-fn fails(args: &[&str], needles: &[&str]) {
-    let out = sedpack(args);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
-    assert_eq!(stderr.trim_end().lines().count(), 1, "one line: {stderr}");
-    for n in needles {
-        assert!(stderr.contains(n), "{args:?}: '{stderr}' lacks '{n}'");
-    }
-}
-
-fn repo(path: &str) -> String {
-    format!("{}/../{path}", env!("CARGO_MANIFEST_DIR"))
-}
 
 #[test]
 fn forms_lis_prints_table1_factors() {
