@@ -14,6 +14,14 @@ pub struct ProfilePoint {
     pub n: f64,
 }
 
+/// A measured porosity to compare the simulated one with (Table 6).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Experiment {
+    pub porosity: f64,
+    /// Standard deviation of the measurement; None when the source does not give it.
+    pub std: Option<f64>,
+}
+
 /// A finished packing job.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct JobRecord {

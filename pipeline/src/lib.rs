@@ -4,10 +4,12 @@
 pub mod campaign;
 pub mod cli;
 pub mod commands;
+pub mod job_file;
 pub mod meshes;
 pub mod output;
 pub mod runner;
 pub mod spec;
+pub mod stored;
 pub mod vtk;
 
 use cli::{Cli, Command, SampleCommand};

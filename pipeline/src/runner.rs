@@ -17,6 +17,7 @@ use tracing::{info, warn};
 
 use crate::meshes;
 use crate::spec::JobSpec;
+use crate::stored;
 
 /// A running job proves it is alive this often.
 const HEARTBEAT: Duration = Duration::from_secs(10);
@@ -319,9 +320,8 @@ fn simulate(
 }
 
 /// A stored job's spec, with its meshes loaded again and checked against their digest.
-fn read_spec(stored: &serde_json::Value) -> anyhow::Result<JobSpec> {
-    let mut spec: JobSpec =
-        serde_json::from_value(stored.clone()).context("the stored spec cannot be read by this version of sedpack")?;
+fn read_spec(json: &serde_json::Value) -> anyhow::Result<JobSpec> {
+    let mut spec = stored::decode(stored::FORMAT, json)?;
     if let Some(library) = &mut spec.packing.grains.meshes {
         meshes::reload(library)?;
     }

@@ -3,7 +3,6 @@
 mod common;
 
 use common::{fails, json, repo, sedpack};
-use serde_json::Value;
 
 #[test]
 fn forms_lis_prints_table1_factors() {

@@ -6,7 +6,7 @@ use nalgebra::{UnitQuaternion, Vector3};
 mod common;
 
 use common::{momenta, settings};
-use solver::dem::{Calibration, Domain, NewBody, Shape, Simulation};
+use solver::dem::{Domain, NewBody, Shape, Simulation};
 
 const G: f64 = 9.81;
 
@@ -94,7 +94,6 @@ fn an_oblique_collision_of_tilted_ellipsoids_conserves_momentum() {
 fn tumble(time_step: f64) -> (f64, f64, f64) {
     let mut s = settings(0.1, 0.5, Vector3::zeros());
     s.time_step = time_step;
-    s.calibration = Calibration::Discrete { time_step };
     let mut sim = Simulation::new(Domain::Periodic { width: 0.1 }, s).unwrap();
     let mut body =
         ellipsoid([4e-3, 2e-3, 1e-3], Vector3::new(0.05, 0.05, 0.05), UnitQuaternion::identity(), Vector3::zeros());

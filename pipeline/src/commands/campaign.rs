@@ -13,6 +13,7 @@ use crate::campaign::read_campaign;
 use crate::cli::{ExportArgs, ResumeArgs, RunArgs, StatusArgs};
 use crate::output::{Table, print_json};
 use crate::runner::{self, RunOptions, Summary};
+use crate::stored;
 
 pub(crate) fn runtime() -> anyhow::Result<tokio::runtime::Runtime> {
     Ok(tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?)
@@ -83,7 +84,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
             .iter()
             .map(|j| NewJob {
                 id: j.id.clone(),
-                spec: serde_json::to_value(&j.spec).expect("a resolved spec serialises"),
+                spec: stored::encode(&j.spec),
                 seed: j.spec.packing.seed,
                 parameters: j.parameters.clone(),
             })

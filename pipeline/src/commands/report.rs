@@ -10,13 +10,13 @@ use store::{ExportRow, Store};
 
 use crate::cli::ReportArgs;
 use crate::commands::campaign::{open_existing, runtime};
-use crate::spec::JobSpec;
+use crate::stored;
 
 /// A finished job as the analysis reads it; None for jobs without a result.
 fn record(row: &ExportRow) -> Option<JobRecord> {
     let result = row.result.as_ref()?;
     // The measured porosity travels in the job's resolved spec.
-    let experiment = serde_json::from_value::<JobSpec>(row.spec.clone())
+    let experiment = stored::decode(stored::FORMAT, &row.spec)
         .ok()
         .and_then(|spec| spec.experiment)
         .map(|e| (e.porosity, e.std.unwrap_or(0.0)));

@@ -24,7 +24,7 @@ struct SampledForms {
 pub fn forms(args: &SampleFormsArgs) -> anyhow::Result<()> {
     let d = &args.distribution;
     let dist = FormDistribution::new(d.mu_fl, d.sigma_fl, d.mu_el, d.sigma_el)?;
-    let sampler = dist.sampler();
+    let sampler = dist.sampler()?;
     let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
     let (mut fl, mut el, mut eq) = (Moments::default(), Moments::default(), Moments::default());
     for _ in 0..args.count {

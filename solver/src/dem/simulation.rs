@@ -13,6 +13,7 @@ use super::contact;
 use super::contact::ellipsoid::EllipsoidPose;
 use super::contact_law::{Calibration, ContactHistory, LinearSpringDashpot};
 use super::domain::Domain;
+use super::material::Material;
 use super::neighbours::NeighbourList;
 use crate::SolverError;
 
@@ -27,16 +28,7 @@ pub const MAX_RELATIVE_OVERLAP: f64 = 0.5;
 /// Material and numerical constants of a simulation (§4.2).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Settings {
-    /// Grain density ρ_p (kg/m³).
-    pub density: f64,
-    /// Fluid density ρ_f (kg/m³); buoyancy reduces the weight to (ρ_p − ρ_f) V g (Eq. 10).
-    pub fluid_density: f64,
-    /// Gravitational acceleration vector (m/s²), (0, 0, −g) for the paper's setups.
-    pub gravity: Vector3<f64>,
-    pub restitution: f64,
-    pub collision_time: f64,
-    pub poisson_ratio: f64,
-    pub friction: f64,
+    pub material: Material,
     pub time_step: f64,
     /// Verlet skin of the neighbour list (m).
     pub skin: f64,
@@ -105,23 +97,17 @@ pub struct Simulation {
 
 impl Simulation {
     pub fn new(domain: Domain, settings: Settings) -> Result<Self, SolverError> {
-        if settings.collision_time / settings.time_step < MIN_STEPS_PER_COLLISION {
+        if settings.material.collision_time / settings.time_step < MIN_STEPS_PER_COLLISION {
             return Err(SolverError::TimeStepTooLarge {
                 time_step: settings.time_step,
-                collision_time: settings.collision_time,
+                collision_time: settings.material.collision_time,
             });
         }
         Ok(Self {
             bodies: Bodies::default(),
             domain,
             settings,
-            law: LinearSpringDashpot::new(
-                settings.restitution,
-                settings.collision_time,
-                settings.poisson_ratio,
-                settings.friction,
-                settings.calibration,
-            ),
+            law: LinearSpringDashpot::new(&settings.material, settings.calibration, settings.time_step),
             neighbours: NeighbourList::new(settings.skin),
             floor_history: Vec::new(),
             wall_history: Vec::new(),
@@ -145,7 +131,7 @@ impl Simulation {
         self.wall_history.push(vec![ContactHistory::default(); body.shape.pieces()]);
         self.refresh_poses();
         self.poses.push(body.shape.pose(body.position, &body.orientation));
-        self.bodies.push(body, self.settings.density)
+        self.bodies.push(body, self.settings.material.density)
     }
 
     /// Recomputes every pose when they are missing (a simulation restored from a checkpoint).
@@ -237,7 +223,7 @@ impl Simulation {
         let neighbours = &self.neighbours;
         let pair_forces = &self.pair_forces;
         let dt = settings.time_step;
-        let weight_per_volume = (settings.density - settings.fluid_density) * settings.gravity;
+        let weight_per_volume = settings.material.weight_per_volume();
         let shaking = self.shaking.map_or(0.0, |s| s.acceleration(self.time));
         let damping = self.damping.map(|c| c.powf(dt));
         let b = &mut self.bodies;

@@ -1,7 +1,10 @@
-//! Meshes built by hand for the tests.
+//! Meshes, settings and packing specs shared by the solver's tests.
 #![allow(dead_code)]
 
 use nalgebra::Vector3;
+use solver::dem::{Calibration, Domain, Material, Settings};
+use solver::grain::SieveCurve;
+use solver::packing::{DomainKind, PackingSpec, ShapeKind};
 
 /// An axis-aligned box with sides (a, b, c) centred at the origin, outward normals, as
 /// (vertices, triangles).
@@ -56,19 +59,24 @@ pub fn rhine_mesh_path(k: usize) -> std::path::PathBuf {
 
 /// The paper's material and time step (§4.2) with the given restitution, friction and gravity
 /// (gravity tilted for slopes), a 1 mm skin and the discrete calibration.
-pub fn settings(restitution: f64, friction: f64, gravity: Vector3<f64>) -> solver::dem::Settings {
-    solver::dem::Settings {
-        density: 2650.0,
-        fluid_density: 1000.0,
-        gravity,
-        restitution,
-        collision_time: 2e-4,
-        poisson_ratio: 0.22,
-        friction,
-        time_step: 5e-6,
-        skin: 1e-3,
-        calibration: solver::dem::Calibration::Discrete { time_step: 5e-6 },
-    }
+pub fn settings(restitution: f64, friction: f64, gravity: Vector3<f64>) -> Settings {
+    let material = Material { restitution, friction, gravity, ..Material::default() };
+    Settings { material, time_step: 5e-6, skin: 1e-3, calibration: Calibration::Discrete }
+}
+
+/// A bed of 5.6–8 mm grains in a 4 cm periodic square 15 cm high, given a generation spacing
+/// and a shaking duration, with 5 s of simulated time to settle; the paper's setup otherwise.
+pub fn small_bed(shape: ShapeKind, mass: f64, spacing: f64, shaking_duration: f64) -> PackingSpec {
+    let mut spec = PackingSpec::paper(DomainKind::Periodic);
+    spec.domain = Domain::Periodic { width: 0.04 };
+    spec.height = Some(0.15);
+    spec.grains.shape = shape;
+    spec.grains.size = SieveCurve::new(vec![5.6e-3, 8e-3], vec![1.0]).unwrap();
+    spec.grains.mass = mass;
+    spec.process.spacing = Some(spacing);
+    spec.process.shaking_duration = shaking_duration;
+    spec.process.max_time = Some(5.0);
+    spec
 }
 
 /// Total linear momentum and angular momentum about the origin of all bodies.
