@@ -21,7 +21,7 @@ pub use cross_validation::{CvError, CvOutcome, assign_folds, cross_validate};
 pub use dataset::{Dataset, DatasetError, DroppedFeature, FeatureKind};
 pub use model::{CrossValidation, LinearModel, ModelError};
 pub use prediction::{FormStatistics, ModelInput, Prediction, PredictionError, load_model, predict};
-pub use record::{CampaignSummary, Experiment, JobRecord, ProfilePoint};
+pub use record::{CampaignSummary, Experiment, JobRecord};
 pub use regression::{Fit, FitError, fit_least_squares};
 pub use report::{ReportError, ReportFiles, write_report};
 pub use selection::{Candidate, FittedModel, Selection, SelectionError, SelectionOptions, select_models};

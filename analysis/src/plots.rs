@@ -6,11 +6,11 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
+use solver::porosity::ProfilePoint;
 use thiserror::Error;
 
 use crate::correlation::CorrelationMatrix;
 use crate::form_factors::symbol;
-use crate::record::ProfilePoint;
 
 #[derive(Debug, Error, PartialEq)]
 #[error("drawing the {figure}: {message}")]

@@ -7,12 +7,13 @@ use std::path::Path;
 use analysis::dataset::mixture_feature_names;
 use analysis::form_factors::{form_feature_names, grain_statistics};
 use analysis::model::LinearModel;
-use analysis::record::{CampaignSummary, JobRecord, ProfilePoint};
+use analysis::record::{CampaignSummary, Experiment, JobRecord};
 use analysis::report::write_report;
 use analysis::selection::SelectionOptions;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde_json::json;
+use solver::porosity::ProfilePoint;
 
 /// Grains of a packing: FL and EL on a 4 × 4 grid at μ ± 0.5σ, ± 1.5σ, clipped to [0.1, 1]
 /// like the sampler's redrawing range.
@@ -211,8 +212,8 @@ fn a_mixture_campaign_report_recovers_the_planted_model() {
 fn validation_campaign() -> Vec<JobRecord> {
     let mut records = Vec::new();
     let cases = [
-        ("U1", [0.382, 0.381, 0.386], (0.371, 0.001), (0.6, 0.7)),
-        ("U3", [0.367, 0.369, 0.372], (0.356, 0.003), (0.5, 0.8)),
+        ("U1", [0.382, 0.381, 0.386], Experiment { porosity: 0.371, std: Some(0.001) }, (0.6, 0.7)),
+        ("U3", [0.367, 0.369, 0.372], Experiment { porosity: 0.356, std: Some(0.003) }, (0.5, 0.8)),
     ];
     for (case, runs, experiment, (fl, el)) in cases {
         for (seed, n) in runs.iter().enumerate() {
@@ -250,6 +251,19 @@ fn a_single_form_validation_report_has_table_6() {
     assert_eq!(rows.len(), 6);
     assert!(md.contains("single-form packings"));
     check_html(out.path(), 3);
+}
+
+#[test]
+fn a_measurement_without_its_spread_is_shown_without_one() {
+    let mut records = validation_campaign();
+    for r in &mut records[3..] {
+        r.experiment = Some(Experiment { porosity: 0.356, std: None });
+    }
+    let out = tempfile::tempdir().unwrap();
+    let files = write_report(&summary("validation", 6), &records, &SelectionOptions::default(), out.path()).unwrap();
+    let md = std::fs::read_to_string(&files.markdown).unwrap();
+    assert!(md.contains("| 0.369 ± 0.002 | 0.356 (spread not given) | 0.013 |"), "{md}");
+    assert!(md.contains("| 0.371 ± 0.001 |") && !md.contains("± 0.000"), "{md}");
 }
 
 #[test]

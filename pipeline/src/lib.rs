@@ -7,6 +7,7 @@ pub mod commands;
 pub mod job_file;
 pub mod meshes;
 pub mod output;
+pub mod records;
 pub mod runner;
 pub mod spec;
 pub mod stored;

@@ -11,11 +11,12 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use solver::packing::{Packing, PackingResult, Phase};
-use store::{GrainStatistic, JobResult, ProfilePoint, Store};
+use store::Store;
 use tokio::sync::mpsc;
 use tracing::{info, warn};
 
 use crate::meshes;
+use crate::records::result_rows;
 use crate::spec::JobSpec;
 use crate::stored;
 
@@ -178,13 +179,13 @@ impl Worker {
             let label: Vec<String> = claimed.parameters.iter().map(|(k, v)| format!("{k}={v}")).collect();
             let label = format!("{} ({})", claimed.id.get(..8).unwrap_or(&claimed.id), label.join(", "));
             info!(job = %claimed.id, worker = %self.id, attempt = claimed.attempts, "started");
-            let outcome = match read_spec(&claimed.spec) {
+            let outcome = match read_spec(claimed.format, &claimed.spec) {
                 Ok(spec) => self.execute(&claimed.id, spec, &label, pool.clone()).await?,
                 Err(e) => Outcome::Failed(format!("{e:#}")),
             };
             match outcome {
                 Outcome::Done(result) => {
-                    let (row, statistics) = store_rows(&result);
+                    let (row, statistics) = result_rows(&result);
                     self.store.complete(&claimed.id, &self.id, &row, &statistics).await?;
                     info!(job = %claimed.id, porosity = result.porosity.bulk, "done");
                     summary.completed += 1;
@@ -320,31 +321,10 @@ fn simulate(
 }
 
 /// A stored job's spec, with its meshes loaded again and checked against their digest.
-fn read_spec(json: &serde_json::Value) -> anyhow::Result<JobSpec> {
-    let mut spec = stored::decode(stored::FORMAT, json)?;
+fn read_spec(format: u32, json: &serde_json::Value) -> anyhow::Result<JobSpec> {
+    let mut spec = stored::decode(format, json)?;
     if let Some(library) = &mut spec.packing.grains.meshes {
         meshes::reload(library)?;
     }
     Ok(spec)
-}
-
-fn store_rows(result: &PackingResult) -> (JobResult, Vec<GrainStatistic>) {
-    let p = &result.porosity;
-    let row = JobResult {
-        porosity: p.bulk,
-        z_minus: p.z_minus,
-        z_plus: p.z_plus,
-        profile: p.profile.iter().map(|q| ProfilePoint { z: q.z, n: q.n }).collect(),
-        particles: result.particles as u64,
-        simulated_time: result.simulated_time,
-        steps: result.steps,
-        wall_time: result.wall_time.as_secs_f64(),
-        solver_version: solver::VERSION.to_string(),
-    };
-    let statistics = result
-        .statistics
-        .iter()
-        .map(|s| GrainStatistic { name: s.name.to_string(), mean: s.mean, std: s.std })
-        .collect();
-    (row, statistics)
 }

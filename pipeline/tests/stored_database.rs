@@ -54,6 +54,10 @@ fn a_database_of_version_0_1_0_resumes_and_reports_the_same_results() {
     for model in &models {
         assert_eq!(read(&out.join("models").join(model)), read(&expected.join("models").join(model)), "{model}");
     }
+    // The campaign's measurement (porosity 0.4, no spread) comes from the stored jobs of 0.1.0.
+    let md = read(&out.join("report.md"));
+    assert!(md.contains("| grains.form.mu_fl = 0.8 | 0.400 | 0.400 | 0.400 (spread not given) | -0.000 |"), "{md}");
+    assert!(!md.contains("± 0.000"), "an unknown spread is not shown as 0: {md}");
 
     // Submitting the campaign file again finds every job by its id: ids did not change.
     let again = ok(&["run", fixture("v0.1.0/fixture.yaml").to_str().unwrap(), "--db", db, "--quiet"]);

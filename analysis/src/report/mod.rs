@@ -17,7 +17,7 @@ use crate::dataset::{Dataset, DatasetError, FeatureKind};
 use crate::form_factors::{factors, symbol};
 use crate::model::LinearModel;
 use crate::plots::{self, PlotError, ScatterPlot, ZinggPacking};
-use crate::record::{CampaignSummary, JobRecord};
+use crate::record::{CampaignSummary, Experiment, JobRecord};
 use crate::selection::{Candidate, Selection, SelectionOptions, select_models, set_label};
 use document::Block;
 
@@ -290,7 +290,7 @@ fn packings_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<()
 
 /// Table 6: runs of the same setup (parameters apart from the seed) against the measurement.
 fn experiment_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
-    let mut groups: Vec<(String, Vec<f64>, (f64, f64))> = Vec::new();
+    let mut groups: Vec<(String, Vec<f64>, Experiment)> = Vec::new();
     for r in records {
         let Some(experiment) = r.experiment else { continue };
         let setup: Vec<String> = r
@@ -315,7 +315,7 @@ fn experiment_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
     let mut differences = Vec::new();
     let rows = groups
         .iter()
-        .map(|(label, runs, (measured, measured_std))| {
+        .map(|(label, runs, experiment)| {
             let mean = runs.iter().sum::<f64>() / runs.len() as f64;
             // Population std of the runs, as Table 6 reports it (its U1 row: 0.382, 0.381, 0.386 → ± 0.002).
             let spread = if runs.len() > 1 {
@@ -324,12 +324,16 @@ fn experiment_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
             } else {
                 format!("{mean:.3}")
             };
+            let measured = experiment.porosity;
             differences.push((mean - measured).abs());
             vec![
                 label.clone(),
                 runs.iter().map(|n| format!("{n:.3}")).collect::<Vec<_>>().join(", "),
                 spread,
-                format!("{measured:.3} ± {measured_std:.3}"),
+                match experiment.std {
+                    Some(std) => format!("{measured:.3} ± {std:.3}"),
+                    None => format!("{measured:.3} (spread not given)"),
+                },
                 format!("{:.3}", mean - measured),
                 format!("{:.2}", 100.0 * (mean - measured) / measured),
             ]

@@ -12,8 +12,8 @@ use store::{CampaignStatus, ExportRow, NewJob, Store};
 use crate::campaign::read_campaign;
 use crate::cli::{ExportArgs, ResumeArgs, RunArgs, StatusArgs};
 use crate::output::{Table, print_json};
+use crate::records::new_job;
 use crate::runner::{self, RunOptions, Summary};
-use crate::stored;
 
 pub(crate) fn runtime() -> anyhow::Result<tokio::runtime::Runtime> {
     Ok(tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?)
@@ -79,16 +79,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     runtime()?.block_on(async {
         let store = Store::open(&args.db).await?;
         store.upsert_campaign(&campaign.name, &campaign.text).await?;
-        let jobs: Vec<NewJob> = campaign
-            .jobs
-            .iter()
-            .map(|j| NewJob {
-                id: j.id.clone(),
-                spec: stored::encode(&j.spec),
-                seed: j.spec.packing.seed,
-                parameters: j.parameters.clone(),
-            })
-            .collect();
+        let jobs: Vec<NewJob> = campaign.jobs.iter().map(new_job).collect();
         let new = store.add_jobs(&campaign.name, &jobs).await?;
         if args.retry_failed {
             let retried = store.requeue_failed(&campaign.name).await?;
