@@ -1,8 +1,10 @@
 //! Porosity models from packing results (§6.3, §7.2 of Rettinger et al. 2022). The analysis
 //! reads plain job records and feature tables by column name; it knows nothing of the DEM or of
-//! SQLite. Data flow: `[JobRecord]` → `Dataset` → `Selection` (ranking, filter, pair and set
-//! fits with k-fold CV) → report files; saved models are applied by `prediction`.
+//! SQLite. Data flow: `[JobRecord]` → `analyse` (the `Dataset`, the factor correlations and the
+//! `Selection`: ranking, filter, pair and set fits with k-fold CV) → `Analysis` → report files,
+//! which only format it; saved models are applied by `prediction`.
 
+pub mod campaign;
 pub mod correlation;
 pub mod cross_validation;
 pub mod dataset;
@@ -16,6 +18,7 @@ pub mod regression;
 pub mod report;
 pub mod selection;
 
+pub use campaign::{Analysis, PACKINGS_PER_FEATURE, Support, analyse};
 pub use correlation::{CorrelationMatrix, FeatureCorrelation, Ranking, correlation_matrix, pearson, rank_features};
 pub use cross_validation::{CvError, CvOutcome, assign_folds, cross_validate};
 pub use dataset::{Dataset, DatasetError, DroppedFeature, FeatureKind};

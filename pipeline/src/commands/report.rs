@@ -1,8 +1,8 @@
 //! `sedpack report NAME --out DIR`: the campaign's porosity models and report (§6.3, §7.2).
 
-use analysis::JobRecord;
 use analysis::report::write_report;
 use analysis::selection::SelectionOptions;
+use analysis::{JobRecord, analyse};
 use anyhow::bail;
 use store::Store;
 
@@ -25,7 +25,8 @@ pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
     let records: Vec<JobRecord> =
         rows.iter().filter_map(|row| job_record(row).transpose()).collect::<Result<_, _>>()?;
     let options = SelectionOptions { threshold: args.threshold, folds: args.folds, seed: args.seed };
-    let files = write_report(&campaign_summary(&status), &records, &options, &args.out)?;
+    let analysis = analyse(&records, &args.name, &options)?;
+    let files = write_report(&campaign_summary(&status), &records, &analysis, &args.out)?;
     println!("{}: report of {} finished job(s)", args.name, records.len());
     println!("  {}", files.html.display());
     println!("  {}", files.markdown.display());
