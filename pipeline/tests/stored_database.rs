@@ -33,6 +33,12 @@ fn a_database_of_version_0_1_0_resumes_and_reports_the_same_results() {
     assert_eq!((status["done"].as_u64(), status["pending"].as_u64()), (Some(3), Some(1)), "{status}");
     let resumed = ok(&["resume", "fixture", "--db", db, "--workers", "1", "--quiet"]);
     assert!(resumed.contains("1 job(s) finished now") && resumed.contains("4 done"), "{resumed}");
+    // The interrupted job's checkpoint is 0.1.0's: the log says it cannot be used, and why.
+    let log = read(&dir.path().join("fixture.log"));
+    let warning = log.lines().find(|l| l.contains("its checkpoint cannot be used")).unwrap_or_else(|| panic!("{log}"));
+    assert!(warning.contains("another version of sedpack wrote it (checkpoint format 0; this version reads 2)"));
+    assert!(warning.contains("starting over") && warning.contains("e4f0b397d28c4f59"), "{warning}");
+    assert!(!log.contains("resuming from a checkpoint"), "{log}");
 
     // Every job, the resumed one included, has the result 0.1.0 computed (wall times aside).
     let export = ok(&["export", "fixture", "--db", db, "--format", "csv"]);
