@@ -11,6 +11,7 @@ use store::{CampaignStatus, ExportRow, NewJob, Store};
 
 use crate::campaign::read_campaign;
 use crate::cli::{ExportArgs, ResumeArgs, RunArgs, StatusArgs};
+use crate::outln;
 use crate::output::{Table, print_json};
 use crate::records::new_job;
 use crate::runner::{self, RunOptions, Summary};
@@ -48,17 +49,23 @@ fn workers(requested: Option<usize>) -> anyhow::Result<usize> {
     }
 }
 
-fn report(name: &str, summary: Summary, status: &CampaignStatus) {
-    println!(
+fn report(name: &str, summary: Summary, status: &CampaignStatus) -> std::io::Result<()> {
+    outln!(
         "{name}: {} job(s) finished now, {} failed now; campaign: {} done, {} failed, {} pending, {} running",
-        summary.completed, summary.failed, status.done, status.failed, status.pending, status.running
-    );
+        summary.completed,
+        summary.failed,
+        status.done,
+        status.failed,
+        status.pending,
+        status.running
+    )?;
     for f in &status.failures {
-        println!("  failed {}: {}", f.job_id, f.error);
+        outln!("  failed {}: {}", f.job_id, f.error)?;
     }
     if summary.interrupted {
-        println!("interrupted: run `sedpack resume {name}` to finish the campaign");
+        outln!("interrupted: run `sedpack resume {name}` to finish the campaign")?;
     }
+    Ok(())
 }
 
 /// `--checkpoint-interval` as a duration: a positive, finite number of seconds.
@@ -83,17 +90,17 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         let new = store.add_jobs(&campaign.name, &jobs).await?;
         if args.retry_failed {
             let retried = store.requeue_failed(&campaign.name).await?;
-            println!("{}: {retried} failed job(s) returned to pending", campaign.name);
+            outln!("{}: {retried} failed job(s) returned to pending", campaign.name)?;
         }
-        println!(
+        outln!(
             "{}: {} job(s), {new} new; database {}, log {}",
             campaign.name,
             jobs.len(),
             args.db.display(),
             log.display()
-        );
+        )?;
         let summary = runner::run(&store, &campaign.name, &options, !args.quiet).await?;
-        report(&campaign.name, summary, &store.status(&campaign.name).await?);
+        report(&campaign.name, summary, &store.status(&campaign.name).await?)?;
         Ok(())
     })
 }
@@ -108,7 +115,7 @@ pub fn resume(args: &ResumeArgs) -> anyhow::Result<()> {
         store.campaign(&args.name).await?;
         start_log(&args.db)?;
         let summary = runner::run(&store, &args.name, &options, !args.quiet).await?;
-        report(&args.name, summary, &store.status(&args.name).await?);
+        report(&args.name, summary, &store.status(&args.name).await?)?;
         Ok(())
     })
 }
@@ -138,13 +145,14 @@ pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
             records.push(status_record(store.status(name).await?));
         }
         if args.json {
-            return match (&args.name, records.pop()) {
-                (Some(_), Some(record)) => print_json(&record),
+            // One object for a named campaign, a list of every campaign otherwise.
+            return match (&args.name, records.as_slice()) {
+                (Some(_), [record]) => print_json(record),
                 _ => print_json(&records),
             };
         }
         if records.is_empty() {
-            println!("no campaigns in {}", args.db.display());
+            outln!("no campaigns in {}", args.db.display())?;
         }
         for r in &records {
             let s = &r.status;
@@ -165,7 +173,7 @@ pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
             for f in &s.failures {
                 table.row(format!("failed {}", f.job_id), f.error.clone());
             }
-            table.print();
+            table.print()?;
         }
         Ok(())
     })

@@ -6,6 +6,7 @@ use solver::grain::simplify::simplify;
 use solver::grain::{EquivalentEllipsoid, FormDistribution, FormParameters, TriMesh, bonded_grain, ellipsoid_mass};
 
 use crate::cli::{DistributionArgs, FormsArgs};
+use crate::outln;
 use crate::output::{Table, number, print_json};
 
 pub fn run(args: &FormsArgs) -> anyhow::Result<()> {
@@ -42,7 +43,7 @@ pub fn run(args: &FormsArgs) -> anyhow::Result<()> {
     if args.json {
         return print_json(&record);
     }
-    println!("{title}");
+    outln!("{title}")?;
     let mut table = Table::default();
     for (key, value) in &record {
         match value {
@@ -78,7 +79,7 @@ pub fn run(args: &FormsArgs) -> anyhow::Result<()> {
             other => table.row(key, other.to_string()),
         };
     }
-    table.print();
+    table.print()?;
     Ok(())
 }
 

@@ -69,7 +69,7 @@ pub fn run(args: &PackArgs) -> anyhow::Result<()> {
         .row("simulated time", format!("{:.3} s in {} steps", record.simulated_time, record.steps))
         .row("wall time", format!("{:.1} s", record.wall_time))
         .row("output", out.display().to_string());
-    table.print();
+    table.print()?;
     Ok(())
 }
 

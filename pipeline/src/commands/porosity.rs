@@ -83,6 +83,6 @@ pub fn run(args: &PorosityArgs) -> anyhow::Result<()> {
         .row("evaluated", format!("{} m – {} m", number(evaluation.z_minus), number(evaluation.z_plus)))
         .row("surface", format!("{} m", number(evaluation.surface)))
         .row("particles", evaluation.particles.to_string());
-    table.print();
+    table.print()?;
     Ok(())
 }

@@ -106,7 +106,7 @@ pub fn run(args: &PredictArgs) -> anyhow::Result<()> {
         table.row(k.as_str(), number(*v));
     }
     table.row("porosity", format!("{:.4}", output.porosity));
-    table.print();
+    table.print()?;
     for w in &output.warnings {
         eprintln!("warning: {w}");
     }

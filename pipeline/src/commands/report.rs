@@ -8,6 +8,7 @@ use store::Store;
 
 use crate::cli::ReportArgs;
 use crate::commands::campaign::{open_existing, runtime};
+use crate::outln;
 use crate::records::{campaign_summary, job_record};
 
 pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
@@ -27,12 +28,12 @@ pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
     let options = SelectionOptions { threshold: args.threshold, folds: args.folds, seed: args.seed };
     let analysis = analyse(&records, &args.name, &options)?;
     let files = write_report(&campaign_summary(&status), &records, &analysis, &args.out)?;
-    println!("{}: report of {} finished job(s)", args.name, records.len());
-    println!("  {}", files.html.display());
-    println!("  {}", files.markdown.display());
-    println!("  {}", files.dataset.display());
+    outln!("{}: report of {} finished job(s)", args.name, records.len())?;
+    outln!("  {}", files.html.display())?;
+    outln!("  {}", files.markdown.display())?;
+    outln!("  {}", files.dataset.display())?;
     for model in &files.models {
-        println!("  {}", model.display());
+        outln!("  {}", model.display())?;
     }
     Ok(())
 }

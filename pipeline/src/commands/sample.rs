@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 use solver::grain::{FormDistribution, FormMoments, SieveCurve};
 
 use crate::cli::{SampleFormsArgs, SampleSizesArgs};
+use crate::outln;
 use crate::output::{Table, number, print_json};
 
 #[derive(Serialize)]
@@ -45,15 +46,15 @@ pub fn forms(args: &SampleFormsArgs) -> anyhow::Result<()> {
     if args.json {
         return print_json(&result);
     }
-    println!("{} grains, seed {} (std: population standard deviation)", args.count, args.seed);
-    println!("{:<4} {:>10} {:>10} {:>14} {:>14}", "", "mean", "std", "expected mean", "expected std");
+    outln!("{} grains, seed {} (std: population standard deviation)", args.count, args.seed)?;
+    outln!("{:<4} {:>10} {:>10} {:>14} {:>14}", "", "mean", "std", "expected mean", "expected std")?;
     let e = &result.expected;
     for (name, m, s, em, es) in [
         ("FL", sampled.mean_fl, sampled.std_fl, e.mean_fl, e.std_fl),
         ("EL", sampled.mean_el, sampled.std_el, e.mean_el, e.std_el),
         ("EQ", sampled.mean_eq, sampled.std_eq, e.mean_eq, e.std_eq),
     ] {
-        println!("{name:<4} {m:>10.5} {s:>10.5} {em:>14.5} {es:>14.5}");
+        outln!("{name:<4} {m:>10.5} {s:>10.5} {em:>14.5} {es:>14.5}")?;
     }
     Ok(())
 }
@@ -137,17 +138,14 @@ pub fn sizes(args: &SampleSizesArgs) -> anyhow::Result<()> {
     if args.json {
         return print_json(&result);
     }
-    println!("{}: {} grains, seed {}", result.curve, result.count, result.seed);
-    println!("{:>18} {:>11} {:>9} {:>9}", "class (mm)", "prescribed", "sampled", "grains");
+    outln!("{}: {} grains, seed {}", result.curve, result.count, result.seed)?;
+    outln!("{:>18} {:>11} {:>9} {:>9}", "class (mm)", "prescribed", "sampled", "grains")?;
     for i in 0..curve.classes() {
         let class = format!("{:.2}–{:.2}", result.sieves[i] * 1e3, result.sieves[i + 1] * 1e3);
-        println!(
-            "{class:>18} {:>11.4} {:>9.4} {:>9}",
-            result.prescribed[i], result.mass_fractions[i], result.grains[i]
-        );
+        outln!("{class:>18} {:>11.4} {:>9.4} {:>9}", result.prescribed[i], result.mass_fractions[i], result.grains[i])?;
     }
     let mut table = Table::default();
     table.row("largest sieve (m)", number(curve.largest_sieve()));
-    table.print();
+    table.print()?;
     Ok(())
 }
