@@ -7,6 +7,7 @@
 pub mod campaign;
 pub mod correlation;
 pub mod cross_validation;
+pub mod csv;
 pub mod dataset;
 pub mod form_factors;
 pub mod model;

@@ -5,7 +5,7 @@ mod common;
 
 use std::process::{Command, Output, Stdio};
 
-use common::{fixture, json, write};
+use common::{fixture_db, json, sphere_campaign, write};
 
 /// Runs sedpack with a standard output whose reader is already gone.
 fn with_closed_stdout(args: &[&str]) -> Output {
@@ -22,9 +22,7 @@ fn with_closed_stdout(args: &[&str]) -> Output {
 #[test]
 fn status_as_json_lists_every_campaign_of_the_database() {
     let dir = tempfile::tempdir().unwrap();
-    let db = dir.path().join("fixture.db");
-    std::fs::copy(fixture("v0.1.0/fixture.db"), &db).unwrap();
-    let db = db.to_str().unwrap();
+    let db = &fixture_db(dir.path());
     let all = json(&["status", "--db", db, "--json"]);
     let names: Vec<&str> = all.as_array().unwrap().iter().map(|c| c["campaign"].as_str().unwrap()).collect();
     assert_eq!(names, ["fixture-spheres", "fixture"]);
@@ -36,9 +34,7 @@ fn status_as_json_lists_every_campaign_of_the_database() {
 #[test]
 fn every_printing_command_ends_quietly_when_the_reader_is_gone() {
     let dir = tempfile::tempdir().unwrap();
-    let db = dir.path().join("fixture.db");
-    std::fs::copy(fixture("v0.1.0/fixture.db"), &db).unwrap();
-    let db = db.to_str().unwrap();
+    let db = &fixture_db(dir.path());
     // A simple cubic lattice of 2 mm spheres, 5 × 5 per layer in a 10 mm box, 10 layers.
     let mut lattice = String::from("x,y,z,r\n");
     for k in 0..250 {
@@ -47,11 +43,7 @@ fn every_printing_command_ends_quietly_when_the_reader_is_gone() {
     }
     let spheres = write(dir.path(), "spheres.csv", &lattice);
     let sizes = write(dir.path(), "sizes.yaml", "sieves: [0.001, 0.002]\nfractions: [1.0]\n");
-    let job = write(
-        dir.path(),
-        "job.yaml",
-        "domain: {kind: periodic, width: 0.03, height: 0.1}\ngrains:\n  shape: sphere\n  size: {sieves: [0.0056, 0.008], fractions: [1.0]}\n  mass: 0.01\nprocess:\n  generation: {spacing: 0.009}\n  shaking: {duration: 0.01}\nevaluation: {trim: 0.0}\n",
-    );
+    let job = write(dir.path(), "job.yaml", &sphere_campaign("job", 0.01, ""));
     let out = dir.path().join("out");
     let report = dir.path().join("report");
     let distribution = ["--mu-fl", "0.6", "--sigma-fl", "0.1", "--mu-el", "0.7", "--sigma-el", "0.1"];

@@ -1,33 +1,24 @@
 //! The runner as a library: when one worker fails, the others stop and every job goes back to
 //! pending before the error is returned.
 
+mod common;
+
 use std::time::Duration;
 
+use common::sphere_campaign;
 use sedpack::campaign::read_campaign;
 use sedpack::records::new_job;
 use sedpack::runner::{RunOptions, run};
 use sqlx::{ConnectOptions, Connection};
 use store::Store;
 
-/// Two sphere packings: one done in a fraction of a second, one shaken for 5 s of simulated time.
-const CAMPAIGN: &str = "name: broken
-domain: {kind: periodic, width: 0.03, height: 0.1}
-grains:
-  shape: sphere
-  size: {sieves: [0.0056, 0.008], fractions: [1.0]}
-  mass: 0.03
-process:
-  generation: {spacing: 0.009}
-evaluation: {trim: 0.004}
-grid:
-  process.shaking.duration: [0.02, 5.0]
-";
-
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_failing_worker_stops_the_others_and_every_job_returns_to_pending() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("broken.yaml");
-    std::fs::write(&file, CAMPAIGN).unwrap();
+    // Two sphere packings: one done in a fraction of a second, one shaken for 5 s.
+    let grid = "grid:\n  process.shaking.duration: [0.02, 5.0]\n";
+    std::fs::write(&file, sphere_campaign("broken", 0.02, grid)).unwrap();
     let campaign = read_campaign(&file).unwrap();
     let db = dir.path().join("broken.db");
     let store = Store::open(&db).await.unwrap();

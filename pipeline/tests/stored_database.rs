@@ -6,7 +6,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{fixture, json, ok};
+use common::{fixture, fixture_db, json, ok};
 
 /// CSV lines as fields, without the column named `skip`.
 fn fields_without(csv: &str, skip: &str) -> Vec<Vec<String>> {
@@ -24,9 +24,7 @@ fn read(path: &Path) -> String {
 #[test]
 fn a_database_of_version_0_1_0_resumes_and_reports_the_same_results() {
     let dir = tempfile::tempdir().unwrap();
-    let db = dir.path().join("fixture.db");
-    std::fs::copy(fixture("v0.1.0/fixture.db"), &db).unwrap();
-    let db = db.to_str().unwrap();
+    let db = &fixture_db(dir.path());
     let spheres_before = ok(&["export", "fixture-spheres", "--db", db, "--format", "csv"]);
 
     let status = json(&["status", "fixture", "--db", db, "--json"]);

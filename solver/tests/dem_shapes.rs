@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{box_mesh, momenta, settings};
+use common::{box_mesh, momenta, settings, slide_x};
 use nalgebra::{UnitQuaternion, Vector3};
 use solver::dem::shape::Polyhedron;
 use solver::dem::{Domain, NewBody, Shape, Simulation};
@@ -31,14 +31,7 @@ fn cube_on_slope(theta_degrees: f64, time: f64) -> (f64, f64) {
     for _ in 0..4000 {
         sim.step().unwrap();
     }
-    let (x0, v0) = (sim.bodies.position[0].x, sim.bodies.velocity[0].x);
-    let n = (time / 5e-6) as usize;
-    for _ in 0..n {
-        sim.step().unwrap();
-    }
-    let t = n as f64 * 5e-6;
-    let dx = sim.bodies.position[0].x - x0;
-    (dx, 2.0 * (dx - v0 * t) / (t * t))
+    slide_x(&mut sim, time)
 }
 
 #[test]

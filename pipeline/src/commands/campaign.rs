@@ -4,6 +4,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
+use analysis::csv;
 use anyhow::{Context, bail};
 use serde::Serialize;
 use serde_json::{Map, Value};
@@ -212,7 +213,7 @@ fn write_csv(out: &mut impl Write, rows: &[ExportRow]) -> anyhow::Result<()> {
         header.push(format!("mean_{name}"));
         header.push(format!("std_{name}"));
     }
-    writeln!(out, "{}", header.join(","))?;
+    writeln!(out, "{}", header.iter().map(|h| csv::field(h)).collect::<Vec<_>>().join(","))?;
     for row in rows {
         let mut fields = vec![row.job_id.clone(), row.state.as_str().to_string(), row.seed.to_string()];
         fields.extend(keys.iter().map(|k| csv_value(row.parameters.get(k))));
@@ -239,12 +240,27 @@ fn write_csv(out: &mut impl Write, rows: &[ExportRow]) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// A grid value as a CSV field: numbers and strings bare, anything else as quoted JSON.
+/// A grid value as a CSV field: a string as its text, anything else as its JSON.
 fn csv_value(value: Option<&Value>) -> String {
     match value {
         None | Some(Value::Null) => String::new(),
-        Some(Value::String(s)) if !s.contains([',', '"', '\n']) => s.clone(),
-        Some(Value::Number(n)) => n.to_string(),
-        Some(other) => format!("\"{}\"", other.to_string().replace('"', "\"\"")),
+        Some(Value::String(s)) => csv::field(s),
+        Some(other) => csv::field(&other.to_string()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use serde_json::json;
+
+    use super::*;
+
+    #[test]
+    fn grid_values_become_csv_fields() {
+        assert_eq!(csv_value(Some(&json!(0.4))), "0.4");
+        assert_eq!(csv_value(Some(&json!("U7"))), "U7");
+        assert_eq!(csv_value(Some(&json!("a,b"))), "\"a,b\"");
+        assert_eq!(csv_value(Some(&json!({"fl": 0.5, "el": 0.6}))), r#""{""fl"":0.5,""el"":0.6}""#);
+        assert_eq!(csv_value(None), "");
     }
 }

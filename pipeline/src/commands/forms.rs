@@ -37,7 +37,7 @@ pub fn run(args: &FormsArgs) -> anyhow::Result<()> {
         let form = FormParameters::new(lis[0], lis[1], lis[2]).context("--bonded")?;
         (bonded_record(&form)?, "bonded-sphere grain (Sun & Xiao, §2.4 and Appendix)".to_string())
     } else {
-        let d = args.distribution().expect("clap requires --lis, --mesh, --bonded or the distribution");
+        let d = args.distribution.given().expect("clap requires --lis, --mesh, --bonded or the distribution");
         (distribution_record(&d)?, "form distribution (§7.1, §7.3)".to_string())
     };
     if args.json {

@@ -26,9 +26,9 @@ pub fn forms(args: &SampleFormsArgs) -> anyhow::Result<()> {
     let d = &args.distribution;
     let dist = FormDistribution::new(d.mu_fl, d.sigma_fl, d.mu_el, d.sigma_el)?;
     let sampler = dist.sampler()?;
-    let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
+    let mut rng = ChaCha8Rng::seed_from_u64(args.draw.seed);
     let (mut fl, mut el, mut eq) = (Moments::default(), Moments::default(), Moments::default());
-    for _ in 0..args.count {
+    for _ in 0..args.draw.count {
         let (f, e) = sampler.sample_flatness_elongation(&mut rng);
         fl.add(f);
         el.add(e);
@@ -42,11 +42,12 @@ pub fn forms(args: &SampleFormsArgs) -> anyhow::Result<()> {
         mean_eq: eq.mean(),
         std_eq: eq.std(),
     };
-    let result = SampledForms { count: args.count, seed: args.seed, sampled, expected: dist.truncated_moments() };
-    if args.json {
+    let result =
+        SampledForms { count: args.draw.count, seed: args.draw.seed, sampled, expected: dist.truncated_moments() };
+    if args.draw.json {
         return print_json(&result);
     }
-    outln!("{} grains, seed {} (std: population standard deviation)", args.count, args.seed)?;
+    outln!("{} grains, seed {} (std: population standard deviation)", args.draw.count, args.draw.seed)?;
     outln!("{:<4} {:>10} {:>10} {:>14} {:>14}", "", "mean", "std", "expected mean", "expected std")?;
     let e = &result.expected;
     for (name, m, s, em, es) in [
@@ -117,10 +118,10 @@ pub fn sizes(args: &SampleSizesArgs) -> anyhow::Result<()> {
         (None, None) => unreachable!("clap requires --case or --sieves"),
     };
     let sampler = curve.sampler();
-    let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
+    let mut rng = ChaCha8Rng::seed_from_u64(args.draw.seed);
     let mut mass = vec![0.0; curve.classes()];
     let mut grains = vec![0u64; curve.classes()];
-    for _ in 0..args.count {
+    for _ in 0..args.draw.count {
         let (class, d) = sampler.sample(&mut rng);
         mass[class] += d.powi(3);
         grains[class] += 1;
@@ -128,14 +129,14 @@ pub fn sizes(args: &SampleSizesArgs) -> anyhow::Result<()> {
     let total: f64 = mass.iter().sum();
     let result = SampledSizes {
         curve: name,
-        count: args.count,
-        seed: args.seed,
+        count: args.draw.count,
+        seed: args.draw.seed,
         sieves: curve.sieves().to_vec(),
         prescribed: curve.fractions().to_vec(),
         mass_fractions: mass.iter().map(|m| m / total).collect(),
         grains,
     };
-    if args.json {
+    if args.draw.json {
         return print_json(&result);
     }
     outln!("{}: {} grains, seed {}", result.curve, result.count, result.seed)?;

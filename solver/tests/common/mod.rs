@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use nalgebra::Vector3;
-use solver::dem::{Calibration, Domain, Material, Settings};
+use solver::dem::{Calibration, Domain, Material, Settings, Simulation};
 use solver::grain::SieveCurve;
 use solver::packing::{DomainKind, PackingSpec, ShapeKind};
 
@@ -77,6 +77,34 @@ pub fn small_bed(shape: ShapeKind, mass: f64, spacing: f64, shaking_duration: f6
     spec.process.shaking_duration = shaking_duration;
     spec.process.max_time = Some(5.0);
     spec
+}
+
+/// Steps until the bodies have separated after their first contact; returns the contact steps.
+pub fn collide(sim: &mut Simulation) -> u64 {
+    let (mut steps, mut touched) = (0, false);
+    for _ in 0..100_000 {
+        sim.step().unwrap();
+        if sim.contacts > 0 {
+            touched = true;
+            steps += 1;
+        } else if touched {
+            return steps;
+        }
+    }
+    panic!("the bodies never met");
+}
+
+/// Steps for `time` s; returns body 0's displacement along x and its acceleration from
+/// x = x₀ + v₀ t + a t²/2.
+pub fn slide_x(sim: &mut Simulation, time: f64) -> (f64, f64) {
+    let (x0, v0) = (sim.bodies.position[0].x, sim.bodies.velocity[0].x);
+    let n = (time / sim.settings.time_step) as usize;
+    for _ in 0..n {
+        sim.step().unwrap();
+    }
+    let t = n as f64 * sim.settings.time_step;
+    let dx = sim.bodies.position[0].x - x0;
+    (dx, 2.0 * (dx - v0 * t) / (t * t))
 }
 
 /// Total linear momentum and angular momentum about the origin of all bodies.
