@@ -39,6 +39,45 @@ pub enum Command {
     Export(ExportArgs),
     /// Fit and cross-validate porosity models on a campaign and write the report.
     Report(ReportArgs),
+    /// Particle-steps per second of the DEM engine on standard settled beds, per shape and
+    /// thread count: how to size a campaign.
+    Bench(BenchArgs),
+}
+
+/// A shape of `sedpack bench`, or all of them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum BenchShape {
+    Sphere,
+    Ellipsoid,
+    Mesh,
+    BondedSpheres,
+    All,
+}
+
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    /// The grains of the bed: spheres (the LAMMPS comparison bed), ellipsoids or bonded
+    /// spheres of the Rhine form distribution, polyhedra of the Rhine scans, or all.
+    #[arg(long, value_enum, default_value = "all")]
+    pub shape: BenchShape,
+    /// Grains in the bed (default: 2,450 spheres, the LAMMPS bed; 2,000 of the other shapes).
+    #[arg(long)]
+    pub grains: Option<usize>,
+    /// Thread counts to measure with, e.g. 1,2 (default: 1 and all cores).
+    #[arg(long, value_delimiter = ',')]
+    pub threads: Vec<usize>,
+    /// Time steps per measurement (default: about 4 million particle-steps).
+    #[arg(long)]
+    pub steps: Option<u64>,
+    /// Folder of the cached beds (default: ~/.cache/sedpack/bench, or $XDG_CACHE_HOME).
+    #[arg(long)]
+    pub cache: Option<PathBuf>,
+    /// Write the sphere bed as a LAMMPS data file here, with an input deck beside it
+    /// (FILE.in) that times LAMMPS on exactly these spheres.
+    #[arg(long)]
+    pub lammps: Option<PathBuf>,
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Debug, Args)]

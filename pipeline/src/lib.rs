@@ -31,5 +31,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Status(args) => commands::campaign::status(&args),
         Command::Export(args) => commands::campaign::export(&args),
         Command::Report(args) => commands::report::run(&args),
+        Command::Bench(args) => commands::bench::run(&args),
     }
 }

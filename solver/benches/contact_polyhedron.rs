@@ -20,8 +20,9 @@ use parry3d_f64::math::{Pose, Rotation as PRotation, Vector as PVector};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use solver::dem::contact::polyhedron::{
-    ConvexPolyhedron, PolyhedronPose, polyhedron_plane, polyhedron_polyhedron, polyhedron_polyhedron_with_stats,
+    PolyhedronPose, polyhedron_plane, polyhedron_polyhedron, polyhedron_polyhedron_with_stats,
 };
+use solver::dem::shape::ConvexPolyhedron;
 use solver::dem::uniform_rotation;
 use solver::grain::pebble::pebble;
 use solver::grain::simplify;
@@ -63,14 +64,22 @@ struct Pair {
     qb: UnitQuaternion<f64>,
     xb: V3,
     previous_normal: V3,
+    /// The rotation matrices of qa and qb.
+    ra: Matrix3<f64>,
+    rb: Matrix3<f64>,
 }
 
 impl Pair {
-    fn poses<'g>(&self, g: &'g Grains) -> (PolyhedronPose<'g>, PolyhedronPose<'g>) {
+    fn poses<'g>(&'g self, g: &'g Grains) -> (PolyhedronPose<'g>, PolyhedronPose<'g>) {
         (
-            PolyhedronPose::new(&g.shapes[self.a], V3::zeros(), self.qa.to_rotation_matrix().matrix()),
-            PolyhedronPose::new(&g.shapes[self.b], self.xb, self.qb.to_rotation_matrix().matrix()),
+            PolyhedronPose::new(&g.shapes[self.a], V3::zeros(), &self.ra),
+            PolyhedronPose::new(&g.shapes[self.b], self.xb, &self.rb),
         )
+    }
+
+    fn set_rotations(&mut self, qa: UnitQuaternion<f64>, qb: UnitQuaternion<f64>) {
+        (self.qa, self.qb) = (qa, qb);
+        (self.ra, self.rb) = (qa.to_rotation_matrix().into_inner(), qb.to_rotation_matrix().into_inner());
     }
 
     fn parry_poses(&self) -> (Pose, Pose) {
@@ -92,7 +101,17 @@ fn pairs(g: &Grains) -> Vec<Pair> {
         let (qa, qb) = (uniform_rotation(&mut rng), uniform_rotation(&mut rng));
         let m = random_unit(&mut rng);
         let size = g.shapes[a].bounding_radius() + g.shapes[b].bounding_radius();
-        let mut pair = Pair { a, b, qa, qb, xb: V3::zeros(), previous_normal: V3::zeros() };
+        let mut pair = Pair {
+            a,
+            b,
+            qa,
+            qb,
+            xb: V3::zeros(),
+            previous_normal: V3::zeros(),
+            ra: Matrix3::zeros(),
+            rb: Matrix3::zeros(),
+        };
+        pair.set_rotations(qa, qb);
         let (mut inside, mut outside) = (0.0, size);
         for _ in 0..60 {
             let t = 0.5 * (inside + outside);
@@ -108,8 +127,9 @@ fn pairs(g: &Grains) -> Vec<Pair> {
         let (pa, pb) = pair.poses(g);
         let Some(contact) = polyhedron_polyhedron(&pa, &pb, None) else { continue };
         pair.previous_normal = contact.normal;
-        pair.qa = UnitQuaternion::from_scaled_axis(random_unit(&mut rng) * 1e-4) * pair.qa;
-        pair.qb = UnitQuaternion::from_scaled_axis(random_unit(&mut rng) * 1e-4) * pair.qb;
+        let qa = UnitQuaternion::from_scaled_axis(random_unit(&mut rng) * 1e-4) * pair.qa;
+        let qb = UnitQuaternion::from_scaled_axis(random_unit(&mut rng) * 1e-4) * pair.qb;
+        pair.set_rotations(qa, qb);
         pair.xb += random_unit(&mut rng) * 1e-6;
         out.push(pair);
     }
@@ -124,7 +144,7 @@ fn report(label: &str, g: &Grains, pairs: &[Pair], warm: bool) {
         gjk += stats.gjk_iterations as u64;
         epa += stats.epa_iterations as u64;
         contacts += contact.is_some() as u64;
-        points += stats.centre_of_pressure as u64;
+        points += stats.centre_of_pressure() as u64;
     }
     let n = pairs.len() as f64;
     eprintln!(

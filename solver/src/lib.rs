@@ -2,6 +2,7 @@
 //! Rettinger et al. (2022) and the porosity evaluation. It knows nothing of job files, campaigns
 //! or databases; the pipeline crate feeds it typed specifications.
 
+pub mod bed;
 pub mod dem;
 pub mod grain;
 pub mod packing;

@@ -20,9 +20,10 @@ use rand_chacha::ChaCha8Rng;
 use solver::dem::contact::ContactGeometry;
 use solver::dem::contact::ellipsoid::EllipsoidPose;
 use solver::dem::contact::polyhedron::{
-    ConvexPolyhedron, PolyhedronPose, polyhedron_cylinder_wall, polyhedron_ellipsoid, polyhedron_plane,
-    polyhedron_polyhedron, polyhedron_polyhedron_with_stats, polyhedron_sphere,
+    PolyhedronPose, polyhedron_cylinder_wall, polyhedron_ellipsoid, polyhedron_plane, polyhedron_polyhedron,
+    polyhedron_polyhedron_with_stats, polyhedron_sphere,
 };
+use solver::dem::shape::ConvexPolyhedron;
 use solver::dem::uniform_rotation;
 use solver::grain::TriMesh;
 
@@ -104,7 +105,7 @@ struct World {
 impl World {
     fn of(pose: &PolyhedronPose) -> Self {
         let shape = pose.shape();
-        let vertices: Vec<V3> = shape.vertices().iter().map(|v| pose.rotation() * v + pose.center()).collect();
+        let vertices: Vec<V3> = shape.vertices().iter().map(|v| pose.map() * v + pose.center()).collect();
         let mut normals = Vec::new();
         let mut edges = Vec::new();
         let mut planes = Vec::new();
@@ -188,7 +189,7 @@ fn overlap_centroid(a: &World, b: &World) -> Option<V3> {
 }
 
 fn parry_pose(pose: &PolyhedronPose) -> Pose {
-    let q = UnitQuaternion::from_matrix(pose.rotation());
+    let q = UnitQuaternion::from_matrix(pose.map());
     let c = pose.center();
     Pose::from_parts(PVector::new(c.x, c.y, c.z), PRotation::from_xyzw(q.i, q.j, q.k, q.w))
 }
@@ -502,7 +503,7 @@ fn random_pairs_match_the_separating_axis_theorem_and_parry() {
                     parry_off += 1;
                 }
                 worst_parry = worst_parry.max((c.depth + p.dist).abs());
-                if stats.centre_of_pressure
+                if stats.centre_of_pressure()
                     && let Some(centroid) = overlap_centroid(&wa, &wb)
                 {
                     let tangential = |x: V3| x - c.normal * c.normal.dot(&x);
@@ -625,29 +626,29 @@ fn polyhedron_sphere_analytic_cases() {
     let depth = 0.01;
     // Over the top face.
     let s = center + V3::new(0.1, -0.2, h + r - depth);
-    let c = polyhedron_sphere(&a, &s, r).unwrap();
+    let c = polyhedron_sphere(&a, &s, r).0.unwrap();
     assert_contact(&c, V3::new(s.x, s.y, center.z + h - 0.5 * depth), V3::z(), depth, 1e-14);
     // Beyond an edge, along its outward diagonal.
     let out = V3::new(1.0, 0.0, 1.0).normalize();
     let edge = center + V3::new(h, 0.15, h);
     let s = edge + out * (r - depth);
-    let c = polyhedron_sphere(&a, &s, r).unwrap();
+    let c = polyhedron_sphere(&a, &s, r).0.unwrap();
     assert_contact(&c, edge - out * (0.5 * depth), out, depth, 1e-14);
     // Beyond a corner.
     let out = V3::new(-1.0, 1.0, -1.0).normalize();
     let corner = center + V3::new(-h, h, -h);
     let s = corner + out * (r - depth);
-    let c = polyhedron_sphere(&a, &s, r).unwrap();
+    let c = polyhedron_sphere(&a, &s, r).0.unwrap();
     assert_contact(&c, corner - out * (0.5 * depth), out, depth, 1e-14);
     // Centre inside, nearest the −y face at 0.1: depth r + 0.1, normal −y.
     let s = center + V3::new(0.05, -h + 0.1, 0.2);
-    let c = polyhedron_sphere(&a, &s, r).unwrap();
+    let c = polyhedron_sphere(&a, &s, r).0.unwrap();
     let face_point = V3::new(s.x, center.y - h, s.z);
     let sphere_deepest = s + V3::y() * r;
     assert_contact(&c, (face_point + sphere_deepest) * 0.5, -V3::y(), r + 0.1, 1e-14);
     // Clear of the corner although inside the corner's bounding box.
     let s = corner + out * (r + 1e-9);
-    assert!(polyhedron_sphere(&a, &s, r).is_none());
+    assert!(polyhedron_sphere(&a, &s, r).0.is_none());
 }
 
 #[test]
@@ -669,7 +670,7 @@ fn polyhedron_sphere_matches_parry() {
             0.0,
         )
         .unwrap();
-        let c = polyhedron_sphere(&a, &s, r);
+        let c = polyhedron_sphere(&a, &s, r).0;
         match (c, p) {
             (Some(c), Some(p)) if p.dist < 0.0 => {
                 worst = worst.max((c.depth + p.dist).abs()).max((c.normal - v3(p.normal1)).norm());
@@ -693,13 +694,13 @@ fn polyhedron_ellipsoid_analytic_cases() {
     let depth = 1e-3;
     // Face down on the top of the ellipsoid: normal −z, point under the ellipsoid's top.
     let above = PolyhedronPose::new(&cube, V3::new(1.1, 2.2, 3.0 + c - depth + h), &rotation(V3::z(), 0.3));
-    let contact = polyhedron_ellipsoid(&above, &e, None).unwrap();
+    let contact = polyhedron_ellipsoid(&above, &e, None).0.unwrap();
     assert_contact(&contact, V3::new(1.0, 2.0, 3.0 + c - 0.5 * depth), -V3::z(), depth, 1e-13);
     // Corner first into the end of the long axis: the vertex lies on the axis, inside by depth
     // (less than the radius of curvature b²/a there), so the normal is the axis.
     let corner = Rotation3::rotation_between(&V3::new(1.0, 1.0, 1.0), &-V3::x()).unwrap().into_inner();
     let beside = PolyhedronPose::new(&cube, V3::new(1.0 + a - depth + 3f64.sqrt() * h, 2.0, 3.0), &corner);
-    let contact = polyhedron_ellipsoid(&beside, &e, None).unwrap();
+    let contact = polyhedron_ellipsoid(&beside, &e, None).0.unwrap();
     assert_contact(&contact, V3::new(1.0 + a - 0.5 * depth, 2.0, 3.0), -V3::x(), depth, 1e-13);
     // Edge along x pressed onto the top (cube turned 45° about x).
     let edge = PolyhedronPose::new(
@@ -707,11 +708,11 @@ fn polyhedron_ellipsoid_analytic_cases() {
         V3::new(1.0, 2.0, 3.0 + c - depth + 2f64.sqrt() * h),
         &rotation(V3::x(), std::f64::consts::FRAC_PI_4),
     );
-    let contact = polyhedron_ellipsoid(&edge, &e, None).unwrap();
+    let contact = polyhedron_ellipsoid(&edge, &e, None).0.unwrap();
     assert_contact(&contact, V3::new(1.0, 2.0, 3.0 + c - 0.5 * depth), -V3::z(), depth, 1e-13);
     // Clear of it.
     let clear = PolyhedronPose::new(&cube, V3::new(1.0, 2.0, 3.0 + c + h + 1e-9), &Matrix3::identity());
-    assert!(polyhedron_ellipsoid(&clear, &e, None).is_none());
+    assert!(polyhedron_ellipsoid(&clear, &e, None).0.is_none());
 }
 
 /// An ellipsoid as parry sees it (support function in its local frame).
@@ -749,7 +750,7 @@ fn polyhedron_ellipsoid_matches_sphere_and_parry() {
         let s = random_unit(&mut rng) * rng.random_range(0.2..1.4);
         // A round ellipsoid is a sphere.
         let round = EllipsoidPose::new(s, &re, V3::repeat(axes.x));
-        match (polyhedron_ellipsoid(&a, &round, None), polyhedron_sphere(&a, &s, axes.x)) {
+        match (polyhedron_ellipsoid(&a, &round, None).0, polyhedron_sphere(&a, &s, axes.x).0) {
             (Some(e), Some(c)) => {
                 worst_sphere[0] = worst_sphere[0].max((e.depth - c.depth).abs());
                 worst_sphere[1] = worst_sphere[1].max((e.normal - c.normal).norm());
@@ -759,10 +760,10 @@ fn polyhedron_ellipsoid_matches_sphere_and_parry() {
             (e, c) => assert!(e.or(c).unwrap().depth < 1e-9, "{e:?} vs {c:?}"),
         }
         let e = EllipsoidPose::new(s, &re, axes);
-        let q = UnitQuaternion::from_matrix(&(a.rotation().transpose() * re));
+        let q = UnitQuaternion::from_matrix(&(a.map().transpose() * re));
         let pos12 = Pose::from_parts(
             {
-                let local = a.rotation().transpose() * s;
+                let local = a.map().transpose() * s;
                 PVector::new(local.x, local.y, local.z)
             },
             PRotation::from_xyzw(q.i, q.j, q.k, q.w),
@@ -774,11 +775,11 @@ fn polyhedron_ellipsoid_matches_sphere_and_parry() {
             let local = re.transpose() * n;
             world.max_along(n) + axes.component_mul(&local).norm() - n.dot(&s)
         };
-        match (polyhedron_ellipsoid(&a, &e, None), p) {
+        match (polyhedron_ellipsoid(&a, &e, None).0, p) {
             (Some(c), Some(p)) if p.dist < 0.0 => {
                 worst_depth = worst_depth.max((c.depth + p.dist).abs());
                 parry_deeper = parry_deeper.max(-p.dist - c.depth);
-                worst_normal = worst_normal.max((c.normal - a.rotation() * v3(p.normal1)).norm());
+                worst_normal = worst_normal.max((c.normal - a.map() * v3(p.normal1)).norm());
                 // Certificate: the depth is f at the normal, and no nearby direction is lower.
                 worst_certificate = worst_certificate.max((c.depth - f(&c.normal)).abs());
                 for _ in 0..20 {

@@ -12,44 +12,77 @@ use solver::grain::{FormParameters, TriMesh, bonded_grain};
 
 const G: f64 = 9.81;
 
-fn cube(side: f64) -> Shape {
-    let (v, t) = box_mesh(side, side, side);
-    Shape::Polyhedron(Box::new(Polyhedron::from_mesh(&TriMesh::new(v, t).unwrap()).unwrap()))
-}
-
 fn body(shape: Shape, position: Vector3<f64>, orientation: UnitQuaternion<f64>, velocity: Vector3<f64>) -> NewBody {
     NewBody { shape, position, orientation, velocity, angular_velocity: Vector3::zeros() }
 }
 
-/// A 10 mm cube resting on a face on a plane inclined by θ (gravity tilted): its displacement
-/// along the slope and its acceleration over `time` s after a settling phase.
-fn cube_on_slope(theta_degrees: f64, time: f64) -> (f64, f64) {
+fn cuboid(a: f64, b: f64, c: f64) -> Shape {
+    let (v, t) = box_mesh(a, b, c);
+    Shape::Polyhedron(Box::new(Polyhedron::from_mesh(&TriMesh::new(v, t).unwrap()).unwrap()))
+}
+
+/// A grain resting on the floor in `orientation` with its centre at `height`, under gravity
+/// tilted by θ (a plane inclined by θ): after 0.1 s of settling, its displacement along the
+/// slope, its acceleration and the angle it turned by over the next `time` s.
+fn on_slope(
+    shape: Shape,
+    orientation: UnitQuaternion<f64>,
+    height: f64,
+    theta_degrees: f64,
+    time: f64,
+) -> (f64, f64, f64) {
     let theta = theta_degrees.to_radians();
     let g = Vector3::new(G * theta.sin(), 0.0, -G * theta.cos());
     let mut sim = Simulation::new(Domain::Periodic { width: 0.1 }, settings(0.1, 0.5, g)).unwrap();
-    sim.add_body(body(cube(0.01), Vector3::new(0.05, 0.05, 0.005), UnitQuaternion::identity(), Vector3::zeros()));
-    for _ in 0..4000 {
+    sim.add_body(body(shape, Vector3::new(0.05, 0.05, height), orientation, Vector3::zeros()));
+    for _ in 0..20_000 {
         sim.step().unwrap();
     }
-    slide_x(&mut sim, time)
+    let q0 = sim.bodies.orientation[0];
+    let (dx, a) = slide_x(&mut sim, time);
+    (dx, a, sim.bodies.orientation[0].angle_to(&q0))
 }
 
 #[test]
 fn a_cube_on_a_slope_sticks_or_slides_by_friction() {
     let g_eff = G * 1650.0 / 2650.0;
-    // tan 20° = 0.36 < μ = 0.5: held by the tangential spring; sliding freely it would cover
-    // g' sin θ t²/2 ≈ 10 mm in 0.1 s. A single contact point on a flat face (the paper's one
-    // point per pair) lets the cube rock at a high frequency about the shifting centre of
-    // pressure, and the rocking ratchets it down the slope at ~0.2 mm/s: below 1 % of the
-    // free slide, without acceleration.
-    let (dx, a) = cube_on_slope(20.0, 0.1);
-    assert!(dx.abs() < 1e-4 && a.abs() < 0.01, "sticks: moved {dx} m, acceleration {a} m/s²");
-    // tan 35° = 0.70 > μ: a = g'(sin θ − μ cos θ) = 1.00 m/s²; the face contact holds the cube
-    // flat, so within 1 %.
-    let theta = 35f64.to_radians();
-    let (_, a) = cube_on_slope(35.0, 0.2);
-    let expected = g_eff * (theta.sin() - 0.5 * theta.cos());
-    assert!((a - expected).abs() < 0.01 * expected, "slides: {a} vs {expected}");
+    let cube_on_slope =
+        |theta, time| on_slope(cuboid(0.01, 0.01, 0.01), UnitQuaternion::identity(), 0.005, theta, time);
+    // Below the friction angle (tan⁻¹ μ = 26.57°) the cube is held by its contact's tangential
+    // springs and, once settled, does not move: at 20° and at 26.5°, where its centre of
+    // pressure sits near the downhill edge, it moves by less than 1 nm in 0.2 s (rounding). With
+    // a single contact point it would rock about that point and ratchet down at ~0.2 mm/s.
+    for theta in [20.0, 26.5] {
+        let (dx, a, turn) = cube_on_slope(theta, 0.2);
+        assert!(dx.abs() < 1e-9 && turn < 1e-9, "{theta}°: moved {dx} m, turned {turn} rad, acceleration {a} m/s²");
+    }
+    // Above it the cube slides flat at a = g'(sin θ − μ cos θ): 0.053 m/s² at 27°, 1.00 m/s² at
+    // 35°, within 1 %.
+    for theta in [27.0f64, 35.0] {
+        let (_, a, _) = cube_on_slope(theta, 0.2);
+        let r = theta.to_radians();
+        let expected = g_eff * (r.sin() - 0.5 * r.cos());
+        assert!((a - expected).abs() < 0.01 * expected, "{theta}°: slides at {a} vs {expected} m/s²");
+    }
+}
+
+#[test]
+fn a_grain_resting_on_any_of_its_faces_neither_tips_nor_creeps() {
+    // A 10 × 6 × 3 mm block on a 10° slope, on each of its six faces: it tips only where
+    // tan θ exceeds its half-width over its half-height along the slope (3/10 at worst), and it
+    // slides only above tan⁻¹ μ, so on every face it must stay put.
+    let faces = [
+        (UnitQuaternion::identity(), 0.0015),
+        (UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI), 0.0015),
+        (UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2), 0.003),
+        (UnitQuaternion::from_axis_angle(&Vector3::x_axis(), -std::f64::consts::FRAC_PI_2), 0.003),
+        (UnitQuaternion::from_axis_angle(&Vector3::y_axis(), std::f64::consts::FRAC_PI_2), 0.005),
+        (UnitQuaternion::from_axis_angle(&Vector3::y_axis(), -std::f64::consts::FRAC_PI_2), 0.005),
+    ];
+    for (k, (q, h)) in faces.into_iter().enumerate() {
+        let (dx, _, turn) = on_slope(cuboid(0.01, 0.006, 0.003), q, h, 10.0, 0.2);
+        assert!(dx.abs() < 1e-9 && turn < 1e-9, "face {k}: moved {dx} m, turned {turn} rad");
+    }
 }
 
 #[test]
@@ -60,7 +93,7 @@ fn a_cube_dropped_on_its_corner_comes_to_rest_on_a_face() {
     let tip = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), 3f64.to_radians());
     let mut sim =
         Simulation::new(Domain::Periodic { width: 0.1 }, settings(0.1, 0.5, Vector3::new(0.0, 0.0, -G))).unwrap();
-    sim.add_body(body(cube(0.01), Vector3::new(0.05, 0.05, 0.0095), tip * onto_corner, Vector3::zeros()));
+    sim.add_body(body(cuboid(0.01, 0.01, 0.01), Vector3::new(0.05, 0.05, 0.0095), tip * onto_corner, Vector3::zeros()));
     for _ in 0..60_000 {
         sim.step().unwrap();
     }

@@ -30,7 +30,7 @@ fn rhine_polyhedra_keep_their_own_forms_and_settle() {
         .map(|m| (m.original_form().s / m.original_form().i, m.original_form().i / m.original_form().l))
         .collect();
     let library = MeshLibrary { source: "builtin:rhine".into(), faces: 300, digest: "test".into(), meshes };
-    let mut packing = Packing::new(spec(ShapeKind::Mesh, FormSpec::Own, Some(library), 0.03)).unwrap();
+    let mut packing = Packing::new(spec(ShapeKind::Mesh, FormSpec::Own, Some(library), 0.05)).unwrap();
     let n = converge(&mut packing);
     let bodies = &packing.simulation.bodies;
     assert!(bodies.len() > 30);
@@ -41,7 +41,8 @@ fn rhine_polyhedra_keep_their_own_forms_and_settle() {
         // rescaled polyhedron has the drawn size D.
         let f = shape.form();
         let (fl, el) = (f.s / f.i, f.i / f.l);
-        assert!(own.iter().any(|&(a, b)| (a - fl).abs() < 1e-9 && (b - el).abs() < 1e-9), "FL {fl}, EL {el}");
+        let off = own.iter().map(|&(a, b)| (a - fl).abs().max((b - el).abs())).fold(f64::INFINITY, f64::min);
+        assert!(off < 1e-9, "FL {fl}, EL {el}: {off:e} from the nearest scan's own");
         assert!((f.size() - record.size).abs() < 1e-12 * record.size);
         assert!((5.6e-3..=8e-3).contains(&record.size));
     }

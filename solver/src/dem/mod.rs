@@ -16,4 +16,4 @@ pub use contact_law::{Calibration, ContactHistory, LinearSpringDashpot};
 pub use domain::Domain;
 pub use material::Material;
 pub use shape::Shape;
-pub use simulation::{MIN_STEPS_PER_COLLISION, Settings, Shaking, Simulation};
+pub use simulation::{Audit, MIN_STEPS_PER_COLLISION, Memory, Settings, Shaking, Simulation, StageTimes};

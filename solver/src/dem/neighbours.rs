@@ -1,11 +1,16 @@
 //! Broad phase: linked cells (with periodic images) build a Verlet list of body pairs whose
 //! bounding spheres come within a skin distance; the list is reused until some body has moved
-//! more than half the skin, and each pair carries its contact history across rebuilds.
+//! more than half the skin, and each pair carries its contact history and narrow-phase cache
+//! across rebuilds.
+//!
+//! The list is simulation state (a checkpoint keeps it); the cell grid and the previous list a
+//! rebuild works with are scratch ([`BuildScratch`]), owned by the step pipeline.
 
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
 use super::body::Bodies;
+use super::contact::PairCache;
 use super::contact_law::ContactHistory;
 use super::domain::Domain;
 use super::shape::Shape;
@@ -33,6 +38,8 @@ pub struct NeighbourList {
     pub pairs: Vec<Pair>,
     /// The contact history of each pair.
     pub history: Vec<ContactHistory>,
+    /// What the narrow phase keeps of each pair.
+    pub cache: Vec<PairCache>,
     /// Positions at the last build; rebuilding is due once a body has moved skin/2 from here.
     reference: Vec<Vector3<f64>>,
     /// Orientations at the last build: the pieces of a bonded grain also move by turning.
@@ -46,17 +53,18 @@ pub struct NeighbourList {
     split: Vec<u32>,
     entries: Vec<u32>,
     pub builds: u64,
-    #[serde(skip)]
-    scratch: Scratch,
 }
 
+/// What a rebuild works with and throws away: the cell grid and the previous list.
 #[derive(Debug, Clone, Default)]
-struct Scratch {
+pub struct BuildScratch {
     cell_start: Vec<u32>,
     cell_bodies: Vec<u32>,
     cell_of: Vec<usize>,
+    fill: Vec<u32>,
     old_pairs: Vec<Pair>,
     old_history: Vec<ContactHistory>,
+    old_cache: Vec<PairCache>,
     old_keys: Vec<[i32; 2]>,
 }
 
@@ -126,6 +134,7 @@ impl NeighbourList {
             skin,
             pairs: Vec::new(),
             history: Vec::new(),
+            cache: Vec::new(),
             reference: Vec::new(),
             reference_orientation: Vec::new(),
             wraps: Vec::new(),
@@ -133,7 +142,6 @@ impl NeighbourList {
             split: Vec::new(),
             entries: Vec::new(),
             builds: 0,
-            scratch: Scratch::default(),
         }
     }
 
@@ -159,6 +167,25 @@ impl NeighbourList {
         })
     }
 
+    /// Bytes held per body: reference positions and orientations, wraps and the pair index.
+    pub fn body_bytes(&self) -> usize {
+        use std::mem::size_of_val;
+        size_of_val(&self.reference[..])
+            + size_of_val(&self.reference_orientation[..])
+            + size_of_val(&self.wraps[..])
+            + size_of_val(&self.offsets[..])
+            + size_of_val(&self.split[..])
+    }
+
+    /// Bytes held per listed pair: the pair, its history and cache, and its two index entries.
+    pub fn pair_bytes(&self) -> usize {
+        use std::mem::size_of_val;
+        size_of_val(&self.pairs[..])
+            + size_of_val(&self.history[..])
+            + size_of_val(&self.cache[..])
+            + size_of_val(&self.entries[..])
+    }
+
     /// Pairs of body `b`: those where it is i, and those where it is j.
     #[inline]
     pub fn pairs_of(&self, b: usize) -> (&[u32], &[u32]) {
@@ -166,17 +193,46 @@ impl NeighbourList {
         (&self.entries[start..split], &self.entries[split..end])
     }
 
-    /// Wraps positions into the periodic box, bins bodies into cells, lists the pairs within
-    /// reach and carries each surviving pair's contact history over.
-    pub fn rebuild(&mut self, bodies: &mut Bodies, domain: &Domain) -> Result<(), SolverError> {
+    /// Rebuilds the list, in stages: wrap positions into the periodic box, bin bodies into
+    /// cells, list the pairs within reach, carry each surviving pair's history and cache over,
+    /// index the pairs by body, and remember where the bodies were.
+    pub fn rebuild(
+        &mut self,
+        bodies: &mut Bodies,
+        domain: &Domain,
+        scratch: &mut BuildScratch,
+    ) -> Result<(), SolverError> {
         self.wraps.resize(bodies.len(), [0, 0]);
-        let old_keys: Vec<[i32; 2]> = self.pairs.iter().map(|p| contact_key(p, &self.wraps)).collect();
+        scratch.old_keys.clear();
+        scratch.old_keys.extend(self.pairs.iter().map(|p| contact_key(p, &self.wraps)));
+        self.wrap(bodies, domain);
+        let grid = self.grid(bodies, domain)?;
+        scratch.bin(bodies, &grid);
+        std::mem::swap(&mut self.pairs, &mut scratch.old_pairs);
+        std::mem::swap(&mut self.history, &mut scratch.old_history);
+        std::mem::swap(&mut self.cache, &mut scratch.old_cache);
+        self.list_pairs(bodies, domain, &grid, scratch);
+        self.carry_over(scratch);
+        self.index_by_body(bodies.len(), &mut scratch.fill);
+        self.reference.clear();
+        self.reference.extend_from_slice(&bodies.position);
+        self.reference_orientation.clear();
+        self.reference_orientation.extend_from_slice(&bodies.orientation);
+        self.builds += 1;
+        Ok(())
+    }
+
+    /// Moves every body back into the periodic box, counting the periods per body.
+    fn wrap(&mut self, bodies: &mut Bodies, domain: &Domain) {
         for (p, w) in bodies.position.iter_mut().zip(&mut self.wraps) {
             let moved = domain.wrap(p);
             w[0] += moved[0];
             w[1] += moved[1];
         }
-        let n = bodies.len();
+    }
+
+    /// The cell grid for the bodies' current extent, with cells as wide as the longest reach.
+    fn grid(&self, bodies: &Bodies, domain: &Domain) -> Result<Grid, SolverError> {
         let r_max = bodies.bounding_radius.iter().cloned().fold(0.0, f64::max);
         let cutoff = 2.0 * r_max + self.skin;
         // A grain must not reach its own periodic image; up to that, a pair may touch through
@@ -186,33 +242,13 @@ impl NeighbourList {
         }
         let (z_lo, z_hi) =
             bodies.position.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.z), hi.max(p.z)));
-        let grid = Grid::new(domain, cutoff, if n == 0 { (0.0, cutoff) } else { (z_lo, z_hi) });
+        Ok(Grid::new(domain, cutoff, if bodies.is_empty() { (0.0, cutoff) } else { (z_lo, z_hi) }))
+    }
 
-        // Counting sort of bodies into cells.
-        let s = &mut self.scratch;
-        s.cell_of.clear();
-        s.cell_of.extend(bodies.position.iter().map(|p| grid.index(grid.coordinates(p))));
-        s.cell_start.clear();
-        s.cell_start.resize(grid.count() + 1, 0);
-        for &c in &s.cell_of {
-            s.cell_start[c + 1] += 1;
-        }
-        for c in 0..grid.count() {
-            s.cell_start[c + 1] += s.cell_start[c];
-        }
-        s.cell_bodies.clear();
-        s.cell_bodies.resize(n, 0);
-        let mut fill = s.cell_start.clone();
-        for (b, &c) in s.cell_of.iter().enumerate() {
-            s.cell_bodies[fill[c] as usize] = b as u32;
-            fill[c] += 1;
-        }
-
-        std::mem::swap(&mut self.pairs, &mut s.old_pairs);
-        std::mem::swap(&mut self.history, &mut s.old_history);
-        s.old_keys = old_keys;
+    /// Every pair of pieces within reach, in the order (i, j, contact key, pieces).
+    fn list_pairs(&mut self, bodies: &Bodies, domain: &Domain, grid: &Grid, s: &BuildScratch) {
         self.pairs.clear();
-        for i in 0..n {
+        for i in 0..bodies.len() {
             let xi = bodies.position[i];
             let ci = grid.coordinates(&xi);
             for dz in -1..=1 {
@@ -253,10 +289,13 @@ impl NeighbourList {
         }
         let wraps = &self.wraps;
         self.pairs.sort_unstable_by_key(|p| (p.i, p.j, contact_key(p, wraps), p.pieces));
+    }
 
-        // Merge by (i, j, contact key, pieces): both lists are sorted that way, so one pass
-        // carries the histories over.
+    /// Gives each listed pair the history and cache it had in the previous list, if it was
+    /// there: both lists are sorted by (i, j, contact key, pieces), so one merge pass does it.
+    fn carry_over(&mut self, s: &BuildScratch) {
         self.history.clear();
+        self.cache.clear();
         let mut k = 0;
         for p in &self.pairs {
             let key = (p.i, p.j, contact_key(p, &self.wraps), p.pieces);
@@ -264,10 +303,18 @@ impl NeighbourList {
             while k < s.old_pairs.len() && old(k) < key {
                 k += 1;
             }
-            let same = k < s.old_pairs.len() && old(k) == key;
-            self.history.push(if same { s.old_history[k] } else { ContactHistory::default() });
+            if k < s.old_pairs.len() && old(k) == key {
+                self.history.push(s.old_history[k]);
+                self.cache.push(s.old_cache[k]);
+            } else {
+                self.history.push(ContactHistory::default());
+                self.cache.push(PairCache::default());
+            }
         }
+    }
 
+    /// Lists each body's pairs: first those where it is i, then those where it is j.
+    fn index_by_body(&mut self, n: usize, cursor: &mut Vec<u32>) {
         self.offsets.clear();
         self.offsets.resize(n + 1, 0);
         for p in &self.pairs {
@@ -279,23 +326,40 @@ impl NeighbourList {
         }
         self.entries.clear();
         self.entries.resize(2 * self.pairs.len(), 0);
-        let mut next: Vec<u32> = self.offsets[..n].to_vec();
+        self.split.clear();
+        self.split.extend_from_slice(&self.offsets[..n]);
         for (k, p) in self.pairs.iter().enumerate() {
-            self.entries[next[p.i as usize] as usize] = k as u32;
-            next[p.i as usize] += 1;
+            self.entries[self.split[p.i as usize] as usize] = k as u32;
+            self.split[p.i as usize] += 1;
         }
-        self.split.clone_from(&next);
+        cursor.clone_from(&self.split);
         for (k, p) in self.pairs.iter().enumerate() {
-            self.entries[next[p.j as usize] as usize] = k as u32;
-            next[p.j as usize] += 1;
+            self.entries[cursor[p.j as usize] as usize] = k as u32;
+            cursor[p.j as usize] += 1;
         }
+    }
+}
 
-        self.reference.clear();
-        self.reference.extend_from_slice(&bodies.position);
-        self.reference_orientation.clear();
-        self.reference_orientation.extend_from_slice(&bodies.orientation);
-        self.builds += 1;
-        Ok(())
+impl BuildScratch {
+    /// Counting sort of the bodies into the grid's cells.
+    fn bin(&mut self, bodies: &Bodies, grid: &Grid) {
+        self.cell_of.clear();
+        self.cell_of.extend(bodies.position.iter().map(|p| grid.index(grid.coordinates(p))));
+        self.cell_start.clear();
+        self.cell_start.resize(grid.count() + 1, 0);
+        for &c in &self.cell_of {
+            self.cell_start[c + 1] += 1;
+        }
+        for c in 0..grid.count() {
+            self.cell_start[c + 1] += self.cell_start[c];
+        }
+        self.cell_bodies.clear();
+        self.cell_bodies.resize(bodies.len(), 0);
+        self.fill.clone_from(&self.cell_start);
+        for (b, &c) in self.cell_of.iter().enumerate() {
+            self.cell_bodies[self.fill[c] as usize] = b as u32;
+            self.fill[c] += 1;
+        }
     }
 }
 
@@ -357,14 +421,14 @@ mod tests {
         let sphere = Shape::Sphere { radius: 3e-3 };
         let mut b = bodies(&[Vector3::new(0.002, 0.02, 0.02), Vector3::new(0.0475, 0.02, 0.02)], sphere);
         let mut list = NeighbourList::new(1e-3);
-        list.rebuild(&mut b, &domain).unwrap();
+        list.rebuild(&mut b, &domain, &mut BuildScratch::default()).unwrap();
         assert_eq!(list.pairs.len(), 1, "one pair, through the boundary");
         list.history[0].tangential_displacement = Vector3::new(0.0, 1e-6, 0.0);
         // Both drift by −3 mm: body 0 leaves through x = 0 and is wrapped to the far side.
         for p in &mut b.position {
             p.x -= 0.003;
         }
-        list.rebuild(&mut b, &domain).unwrap();
+        list.rebuild(&mut b, &domain, &mut BuildScratch::default()).unwrap();
         assert!(b.position[0].x > 0.04, "body 0 was wrapped");
         assert_eq!(list.pairs.len(), 1);
         assert_eq!(list.history[0].tangential_displacement, Vector3::new(0.0, 1e-6, 0.0));
@@ -378,14 +442,14 @@ mod tests {
         let needle = Shape::Ellipsoid { semi_axes: Vector3::new(7e-3, 2e-3, 2e-3) };
         let mut b = bodies(&[Vector3::new(0.005, 0.01, 0.01), Vector3::new(0.015, 0.01, 0.01)], needle.clone());
         let mut list = NeighbourList::new(5e-4);
-        list.rebuild(&mut b, &domain).unwrap();
+        list.rebuild(&mut b, &domain, &mut BuildScratch::default()).unwrap();
         let images: Vec<[i16; 2]> = list.pairs.iter().map(|p| p.image).collect();
         assert_eq!(images, vec![[-1, 0], [0, 0]]);
         // A grain reaching its own image is refused.
         let mut long =
             bodies(&[Vector3::new(0.01, 0.01, 0.01)], Shape::Ellipsoid { semi_axes: Vector3::new(0.0101, 2e-3, 2e-3) });
         assert!(matches!(
-            NeighbourList::new(5e-4).rebuild(&mut long, &domain),
+            NeighbourList::new(5e-4).rebuild(&mut long, &domain, &mut BuildScratch::default()),
             Err(SolverError::DomainTooNarrow { .. })
         ));
     }

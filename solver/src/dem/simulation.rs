@@ -1,6 +1,10 @@
-//! One DEM time step, read as the algorithm: neighbours → contacts → forces and integration.
-//! The packing protocol decides only which external forces apply (gravity and buoyancy, the
-//! shaking of Eq. 14, the damping of Eq. 15).
+//! One DEM time step, read as the algorithm: neighbours → poses → contacts → forces and
+//! integration. The packing protocol decides only which external forces apply (gravity and
+//! buoyancy, the shaking of Eq. 14, the damping of Eq. 15).
+//!
+//! The simulation's state (bodies, contacts with their histories, time) is what a checkpoint
+//! keeps; the step's working memory (pair forces, poses, the neighbour grid) is a separate
+//! [`Pipeline`], filled afresh every step, so a restored simulation needs no repair.
 
 use std::time::{Duration, Instant};
 
@@ -10,11 +14,12 @@ use serde::{Deserialize, Serialize};
 
 use super::body::{Bodies, NewBody};
 use super::contact;
-use super::contact::ellipsoid::EllipsoidPose;
+use super::contact::{Mode, PairCache};
 use super::contact_law::{Calibration, ContactHistory, LinearSpringDashpot};
 use super::domain::Domain;
 use super::material::Material;
-use super::neighbours::NeighbourList;
+use super::neighbours::{BuildScratch, NeighbourList};
+use super::shape::{Pose, Shape};
 use crate::SolverError;
 
 /// Time steps per collision below which the linear spring-dashpot is not resolved (the paper
@@ -60,6 +65,69 @@ struct PairForce {
     torque_j: Vector3<f64>,
 }
 
+/// The narrow phase's shortcuts against the full query over one step's pairs
+/// ([`Simulation::audit_next_step`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Audit {
+    /// Non-spherical pairs looked at.
+    pub pairs: usize,
+    /// Pairs skipped as certainly apart, and of those the ones the full query finds touching.
+    pub skipped: usize,
+    pub wrongly_skipped: usize,
+    /// Contacts both found, and pairs only one of the two found in contact.
+    pub contacts: usize,
+    pub mismatched: usize,
+    /// Largest differences in depth and point relative to the pair's size (the sum of the
+    /// pieces' bounding radii), and in the normal's direction (radians).
+    pub depth: f64,
+    pub point: f64,
+    pub normal: f64,
+}
+
+impl Audit {
+    /// The larger of each figure.
+    pub fn merge(&mut self, other: &Audit) {
+        self.pairs += other.pairs;
+        self.skipped += other.skipped;
+        self.wrongly_skipped += other.wrongly_skipped;
+        self.contacts += other.contacts;
+        self.mismatched += other.mismatched;
+        self.depth = self.depth.max(other.depth);
+        self.point = self.point.max(other.point);
+        self.normal = self.normal.max(other.normal);
+    }
+}
+
+/// Wall contact points a body keeps at most; a bonded grain lying flat on the floor touches it
+/// with many spheres.
+const MAX_WALL_POINTS: usize = 64;
+
+/// What a body keeps of one point of its contact with a wall.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct WallPoint {
+    /// The wall and the body's piece, and the key of the manifold point (its vertex or edge).
+    pub key: (u32, u64),
+    pub history: ContactHistory,
+}
+
+impl WallPoint {
+    fn key(wall: u32, piece: usize, feature: u64) -> (u32, u64) {
+        (wall << 16 | piece as u32, feature)
+    }
+}
+
+/// Memory held by a simulation ([`Simulation::memory`]), in bytes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Memory {
+    /// Everything kept per body: its state, shape, wall histories, pose and neighbour index.
+    pub bodies: usize,
+    /// Everything kept per listed pair: the pair, its contact history, narrow-phase cache and
+    /// force.
+    pub pairs: usize,
+    /// The base meshes of polyhedron grains, each counted once however many grains share it.
+    pub shared_meshes: usize,
+}
+
 /// Wall-clock time spent in each stage since the simulation began.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct StageTimes {
@@ -75,9 +143,8 @@ pub struct Simulation {
     pub settings: Settings,
     law: LinearSpringDashpot,
     neighbours: NeighbourList,
-    /// Per body, the history of each piece's contact with the floor and with the cylinder wall.
-    floor_history: Vec<Vec<ContactHistory>>,
-    wall_history: Vec<Vec<ContactHistory>>,
+    /// Per body, the points of its open contacts with the floor and the cylinder wall.
+    walls: Vec<Vec<WallPoint>>,
     pub time: f64,
     pub steps: u64,
     /// Shaking force applied in the current phase, if any.
@@ -86,13 +153,23 @@ pub struct Simulation {
     pub damping: Option<f64>,
     /// Contacts (pair and wall) open in the last step.
     pub contacts: usize,
+    /// Of those, the contacts between pieces of two bodies.
+    #[serde(default)]
+    pub pair_contacts: usize,
     #[serde(skip)]
+    pipeline: Pipeline,
+}
+
+/// The working memory of a step: overwritten every step, never part of the state.
+#[derive(Debug, Clone, Default)]
+struct Pipeline {
+    /// Force and torques of each listed pair.
     pair_forces: Vec<PairForce>,
-    /// Narrow-phase ellipsoid of every non-spherical body at the current orientation.
-    #[serde(skip)]
-    poses: Vec<Option<EllipsoidPose>>,
-    #[serde(skip)]
-    pub stage_times: StageTimes,
+    /// What the narrow phase precomputes of each body for this step.
+    poses: Vec<Pose>,
+    /// The neighbour list's cell grid and previous list.
+    build: BuildScratch,
+    stage_times: StageTimes,
 }
 
 impl Simulation {
@@ -109,17 +186,26 @@ impl Simulation {
             settings,
             law: LinearSpringDashpot::new(&settings.material, settings.calibration, settings.time_step),
             neighbours: NeighbourList::new(settings.skin),
-            floor_history: Vec::new(),
-            wall_history: Vec::new(),
+            walls: Vec::new(),
             time: 0.0,
             steps: 0,
             shaking: None,
             damping: None,
             contacts: 0,
-            pair_forces: Vec::new(),
-            poses: Vec::new(),
-            stage_times: StageTimes::default(),
+            pair_contacts: 0,
+            pipeline: Pipeline::default(),
         })
+    }
+
+    /// Wall-clock time spent in each stage of the step since this simulation was created or
+    /// restored.
+    pub fn stage_times(&self) -> StageTimes {
+        self.pipeline.stage_times
+    }
+
+    /// The neighbour list: listed pairs, their contact histories and narrow-phase caches.
+    pub fn neighbours(&self) -> &NeighbourList {
+        &self.neighbours
     }
 
     pub fn law(&self) -> &LinearSpringDashpot {
@@ -127,28 +213,17 @@ impl Simulation {
     }
 
     pub fn add_body(&mut self, body: NewBody) -> usize {
-        self.floor_history.push(vec![ContactHistory::default(); body.shape.pieces()]);
-        self.wall_history.push(vec![ContactHistory::default(); body.shape.pieces()]);
-        self.refresh_poses();
-        self.poses.push(body.shape.pose(body.position, &body.orientation));
+        self.walls.push(Vec::new());
         self.bodies.push(body, self.settings.material.density)
-    }
-
-    /// Recomputes every pose when they are missing (a simulation restored from a checkpoint).
-    fn refresh_poses(&mut self) {
-        if self.poses.len() != self.bodies.len() {
-            let b = &self.bodies;
-            self.poses = (0..b.len()).map(|k| b.shape[k].pose(b.position[k], &b.orientation[k])).collect();
-        }
     }
 
     /// Advances the simulation by one time step Δt.
     pub fn step(&mut self) -> Result<(), SolverError> {
         let start = Instant::now();
-        self.refresh_poses();
         if self.neighbours.is_stale(&self.bodies) {
-            self.neighbours.rebuild(&mut self.bodies, &self.domain)?;
+            self.neighbours.rebuild(&mut self.bodies, &self.domain, &mut self.pipeline.build)?;
         }
+        self.pose_bodies();
         let after_neighbours = Instant::now();
         let (pair_contacts, worst_overlap) = self.pair_contacts();
         let after_contacts = Instant::now();
@@ -161,12 +236,70 @@ impl Simulation {
             return Err(SolverError::NotFinite { time: self.time });
         }
         self.contacts = pair_contacts + wall_contacts;
+        self.pair_contacts = pair_contacts;
         self.time += self.settings.time_step;
         self.steps += 1;
-        self.stage_times.neighbours += after_neighbours - start;
-        self.stage_times.contacts += after_contacts - after_neighbours;
-        self.stage_times.bodies += end - after_contacts;
+        let times = &mut self.pipeline.stage_times;
+        times.neighbours += after_neighbours - start;
+        times.contacts += after_contacts - after_neighbours;
+        times.bodies += end - after_contacts;
         Ok(())
+    }
+
+    /// Compares the narrow phase's shortcuts (pairs skipped as apart, polyhedron contacts from
+    /// last step's features, closed-form centres of pressure) with the full query, cold, on
+    /// every non-spherical pair of the coming step, leaving the state as it was (but for a
+    /// neighbour list rebuilt if one was due, as the step would).
+    pub fn audit_next_step(&mut self) -> Result<Audit, SolverError> {
+        if self.neighbours.is_stale(&self.bodies) {
+            self.neighbours.rebuild(&mut self.bodies, &self.domain, &mut self.pipeline.build)?;
+        }
+        self.pose_bodies();
+        let (bodies, poses) = (&self.bodies, &self.pipeline.poses);
+        let mut audit = Audit::default();
+        for (k, pair) in self.neighbours.pairs.iter().enumerate().filter(|(_, p)| !p.spheres) {
+            let (i, j) = (pair.i as usize, pair.j as usize);
+            let xi = bodies.position[i];
+            let xj = bodies.position[j] + self.domain.shift(pair.image);
+            let [ka, kb] = pair.pieces.map(usize::from);
+            let a = bodies.shape[i].piece(ka, xi, &bodies.orientation[i], &poses[i]);
+            let b = bodies.shape[j].piece(kb, xj, &bodies.orientation[j], &poses[j]);
+            let travel = bodies.travel[i] + bodies.travel[j];
+            let full = contact::between(&a, &b, &mut Vector3::zeros(), &mut PairCache::default(), travel, Mode::Full);
+            audit.pairs += 1;
+            let cache = self.neighbours.cache[k];
+            if cache.still_apart(travel) {
+                audit.skipped += 1;
+                audit.wrongly_skipped += usize::from(full.is_some());
+                continue;
+            }
+            let mut warm = self.neighbours.history[k].normal;
+            let fast = contact::between(&a, &b, &mut warm, &mut cache.clone(), travel, Mode::Coherent);
+            let size = a.bounding_radius() + b.bounding_radius();
+            match (full, fast) {
+                (Some(f), Some(c)) => {
+                    audit.contacts += 1;
+                    audit.depth = audit.depth.max((f.depth - c.depth).abs() / size);
+                    audit.point = audit.point.max((f.point - c.point).norm() / size);
+                    audit.normal = audit.normal.max(f.normal.angle(&c.normal));
+                }
+                (None, None) => {}
+                _ => audit.mismatched += 1,
+            }
+        }
+        Ok(audit)
+    }
+
+    /// The poses of this step for the bodies whose shapes need one (ellipsoids, polyhedra).
+    fn pose_bodies(&mut self) {
+        let b = &self.bodies;
+        let poses = &mut self.pipeline.poses;
+        poses.resize(b.len(), Pose::None);
+        poses.par_iter_mut().enumerate().for_each(|(k, pose)| {
+            if matches!(b.shape[k], Shape::Ellipsoid { .. } | Shape::Polyhedron(_)) {
+                *pose = b.shape[k].pose(b.position[k], &b.orientation[k]);
+            }
+        });
     }
 
     /// Narrow phase and contact law for every listed pair; returns the number of open contacts
@@ -174,37 +307,46 @@ impl Simulation {
     fn pair_contacts(&mut self) -> (usize, f64) {
         let bodies = &self.bodies;
         let domain = self.domain;
-        let poses = &self.poses;
+        let poses = &self.pipeline.poses;
         let law = &self.law;
         let dt = self.settings.time_step;
-        self.pair_forces.resize(self.neighbours.pairs.len(), PairForce::default());
+        self.pipeline.pair_forces.resize(self.neighbours.pairs.len(), PairForce::default());
         let pairs = &self.neighbours.pairs;
         pairs
             .par_iter()
             .zip(self.neighbours.history.par_iter_mut())
-            .zip(self.pair_forces.par_iter_mut())
-            .map(|((pair, history), out)| {
+            .zip(self.neighbours.cache.par_iter_mut())
+            .zip(self.pipeline.pair_forces.par_iter_mut())
+            .map(|(((pair, history), cache), out)| {
                 let (i, j) = (pair.i as usize, pair.j as usize);
-                let xi = bodies.position[i];
-                let xj = bodies.position[j] + domain.shift(pair.image);
                 let (geometry, scale) = if pair.spheres {
                     // Sphere beds spend most of their time here: no shape to load, no piece to build.
+                    let xi = bodies.position[i];
+                    let xj = bodies.position[j] + domain.shift(pair.image);
                     let (ra, rb) = (bodies.bounding_radius[i], bodies.bounding_radius[j]);
                     (contact::sphere::sphere_sphere(&xi, ra, &xj, rb), ra.min(rb))
                 } else {
+                    let travel = bodies.travel[i] + bodies.travel[j];
+                    if cache.still_apart(travel) {
+                        history.tangential_displacement = Vector3::zeros();
+                        *out = PairForce::default();
+                        return (0, 0.0);
+                    }
+                    let xi = bodies.position[i];
+                    let xj = bodies.position[j] + domain.shift(pair.image);
                     let [ka, kb] = pair.pieces.map(usize::from);
-                    let a = bodies.shape[i].piece(ka, xi, &bodies.orientation[i], poses[i].as_ref());
-                    let b = bodies.shape[j].piece(kb, xj, &bodies.orientation[j], poses[j].as_ref());
+                    let a = bodies.shape[i].piece(ka, xi, &bodies.orientation[i], &poses[i]);
+                    let b = bodies.shape[j].piece(kb, xj, &bodies.orientation[j], &poses[j]);
                     let scale = a.smallest_half_extent().min(b.smallest_half_extent());
-                    (contact::between(&a, &b, &mut history.normal), scale)
+                    (contact::between(&a, &b, &mut history.normal, cache, travel, Mode::Coherent), scale)
                 };
                 let Some(geometry) = geometry else {
                     history.tangential_displacement = Vector3::zeros();
                     *out = PairForce::default();
                     return (0, 0.0);
                 };
-                let arm_i = geometry.point - xi;
-                let arm_j = geometry.point - xj;
+                let arm_i = geometry.point - bodies.position[i];
+                let arm_j = geometry.point - (bodies.position[j] + domain.shift(pair.image));
                 let relative = bodies.point_velocity(j, &arm_j) - bodies.point_velocity(i, &arm_i);
                 let force = law.force(pair.effective_mass, &geometry, &relative, history, dt);
                 *out = PairForce { force, torque_i: force.cross(&arm_i), torque_j: arm_j.cross(&force) };
@@ -221,7 +363,8 @@ impl Simulation {
         let law = &self.law;
         let domain = self.domain;
         let neighbours = &self.neighbours;
-        let pair_forces = &self.pair_forces;
+        let pair_forces = &self.pipeline.pair_forces;
+        let poses = &self.pipeline.poses;
         let dt = settings.time_step;
         let weight_per_volume = settings.material.weight_per_volume();
         let shaking = self.shaking.map_or(0.0, |s| s.acceleration(self.time));
@@ -232,14 +375,14 @@ impl Simulation {
             b.orientation.par_iter_mut(),
             b.velocity.par_iter_mut(),
             b.angular_velocity.par_iter_mut(),
-            self.floor_history.par_iter_mut(),
-            self.wall_history.par_iter_mut(),
-            self.poses.par_iter_mut(),
+            b.travel.par_iter_mut(),
+            self.walls.par_iter_mut(),
         )
             .into_par_iter()
             .enumerate()
-            .map(|(k, (x, q, v, w, floor, wall, pose))| {
+            .map(|(k, (x, q, v, w, travel, walls))| {
                 let shape = &b.shape[k];
+                let pose = &poses[k];
                 let mass = b.mass[k];
                 let mut force = weight_per_volume * b.volume[k] + Vector3::new(mass * shaking, 0.0, 0.0);
                 let mut torque = Vector3::zeros();
@@ -254,25 +397,37 @@ impl Simulation {
                     force += pf.force;
                     torque += pf.torque_j;
                 }
-                let mut wall_contacts = 0;
-                for (k, (floor, wall)) in floor.iter_mut().zip(wall.iter_mut()).enumerate() {
-                    let piece = shape.piece(k, *x, q, pose.as_ref());
-                    for (geometry, history) in
-                        [(contact::with_floor(&piece), &mut *floor), (contact::with_wall(&piece, &domain), &mut *wall)]
+                // Each wall contact is one point or a face's manifold; every point keeps its
+                // tangential history under its key (wall, piece, vertex) while it stays open.
+                let mut open = [WallPoint::default(); MAX_WALL_POINTS];
+                let mut n_open = 0;
+                for piece in 0..shape.pieces() {
+                    let p = shape.piece(piece, *x, q, pose);
+                    for (wall, manifold) in
+                        [(0, contact::with_floor_manifold(&p)), (1, contact::with_wall_manifold(&p, &domain))]
                     {
-                        let Some(g) = geometry else {
-                            *history = ContactHistory::default();
-                            continue;
-                        };
-                        // The wall is body B, immovable: m_eff = m and its velocity is zero.
-                        let arm = g.point - *x;
-                        let relative = -(*v + w.cross(&arm));
-                        let f = -law.force(mass, &g, &relative, history, dt);
-                        force += f;
-                        torque += arm.cross(&f);
-                        wall_contacts += 1;
+                        let Some(m) = manifold else { continue };
+                        for j in 0..m.len {
+                            let key = WallPoint::key(wall, piece, m.features[j]);
+                            let mut history =
+                                walls.iter().find(|e| e.key == key).map_or_else(ContactHistory::default, |e| e.history);
+                            let g = m.point(j);
+                            // The wall is body B, immovable: m_eff = m and its velocity is zero.
+                            let arm = g.point - *x;
+                            let relative = -(*v + w.cross(&arm));
+                            let f = -law.force(mass * m.weights[j], &g, &relative, &mut history, dt);
+                            force += f;
+                            torque += arm.cross(&f);
+                            if n_open < MAX_WALL_POINTS {
+                                open[n_open] = WallPoint { key, history };
+                                n_open += 1;
+                            }
+                        }
                     }
                 }
+                let wall_contacts = n_open;
+                walls.clear();
+                walls.extend_from_slice(&open[..n_open]);
 
                 *v += force * (dt / mass);
                 let inertia = b.inertia[k];
@@ -287,6 +442,8 @@ impl Simulation {
                     *w += q.transform_vector(&body_wdot) * dt;
                 }
                 *x += *v * dt;
+                // The centre moves by |v| Δt and the body turns by at most |ω| Δt (below).
+                *travel += (v.norm() + w.norm() * b.bounding_radius[k]) * dt;
                 // q ← q + ½ Δt (0, ω) q, exact to O((|ω|Δt)³) per step, then renormalised by one
                 // Newton step for 1/|q| about 1: |q|² − 1 is O((|ω|Δt)²), so the error is of
                 // its square, below round-off, and no square root or division is needed.
@@ -296,13 +453,44 @@ impl Simulation {
                     *v *= c;
                     *w *= c;
                 }
-                if pose.is_some() {
-                    *pose = shape.pose(*x, q);
-                }
                 // The sum is finite exactly when every component is (NaN and ±∞ propagate).
                 (wall_contacts, (x.sum() + v.sum() + w.sum()).is_finite())
             })
             .reduce(|| (0, true), |a, b| (a.0 + b.0, a.1 && b.1))
+    }
+
+    /// Bytes of memory the simulation holds: per body and per listed pair (state and the step's
+    /// working memory), and the base meshes that polyhedron grains share.
+    pub fn memory(&self) -> Memory {
+        use std::mem::size_of_val;
+        let b = &self.bodies;
+        let arrays = size_of_val(&b.position[..])
+            + size_of_val(&b.orientation[..])
+            + size_of_val(&b.velocity[..])
+            + size_of_val(&b.angular_velocity[..])
+            + size_of_val(&b.mass[..])
+            + size_of_val(&b.inertia[..])
+            + size_of_val(&b.volume[..])
+            + size_of_val(&b.shape[..])
+            + size_of_val(&b.bounding_radius[..])
+            + size_of_val(&b.travel[..]);
+        let shapes: usize = b.shape.iter().map(Shape::heap_bytes).sum();
+        let walls: usize =
+            self.walls.iter().map(|h| size_of_val(h) + h.capacity() * std::mem::size_of::<WallPoint>()).sum();
+        let mut meshes: Vec<&std::sync::Arc<super::shape::ConvexPolyhedron>> = Vec::new();
+        for shape in &b.shape {
+            if let Shape::Polyhedron(p) = shape
+                && !meshes.iter().any(|m| std::sync::Arc::ptr_eq(m, &p.base))
+            {
+                meshes.push(&p.base);
+            }
+        }
+        let pipeline = &self.pipeline;
+        Memory {
+            bodies: arrays + shapes + walls + self.neighbours.body_bytes() + size_of_val(&pipeline.poses[..]),
+            pairs: self.neighbours.pair_bytes() + size_of_val(&pipeline.pair_forces[..]),
+            shared_meshes: meshes.iter().map(|m| m.heap_bytes()).sum(),
+        }
     }
 
     /// Mass-averaged height ⟨z⟩ = Σ m z / Σ m (§4.3).

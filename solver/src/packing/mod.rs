@@ -7,6 +7,7 @@ mod spec;
 
 pub use spec::{Derived, DomainKind, FormSpec, GrainSpec, PackingSpec, Process, ShapeKind, SpecError, in_range};
 
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use nalgebra::Vector3;
@@ -16,7 +17,7 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::SolverError;
-use crate::dem::shape::Polyhedron;
+use crate::dem::shape::{ConvexPolyhedron, Polyhedron};
 use crate::dem::{NewBody, Settings, Shape, Simulation, uniform_rotation};
 use crate::grain::{
     FormParameters, FormSampler, FormStatistic, MeshLibrary, SizeSampler, bonded_grain, form_statistics,
@@ -114,6 +115,9 @@ pub struct Packing {
     next_check: f64,
     last_height: Option<f64>,
     wall_time: Duration,
+    /// The convex base shape of each mesh of the library, shared by the grains drawn from it.
+    #[serde(skip)]
+    bases: Vec<Arc<ConvexPolyhedron>>,
 }
 
 /// Steps between checks of whether the last set has left the generation region.
@@ -150,6 +154,7 @@ impl Packing {
             next_check: 0.0,
             last_height: None,
             wall_time: Duration::ZERO,
+            bases: Vec::new(),
             spec,
             derived,
         })
@@ -251,6 +256,13 @@ impl Packing {
             FormSpec::Single { .. } | FormSpec::Own => None,
         };
         let meshes = spec.grains.meshes.as_ref().map_or(&[][..], |m| &m.meshes[..]);
+        if self.bases.len() != meshes.len() {
+            self.bases = meshes
+                .iter()
+                .map(|m| ConvexPolyhedron::new(m.mesh()).map(Arc::new))
+                .collect::<Result<_, _>>()
+                .map_err(|e| PackingError::Meshes(e.to_string()))?;
+        }
         let u = spec.process.velocity;
         self.set_start = self.simulation.bodies.len();
         for &position in &self.grid {
@@ -258,7 +270,8 @@ impl Packing {
                 break;
             }
             let (class, size) = sizes.sample(&mut self.rng);
-            let mesh = (spec.grains.shape == ShapeKind::Mesh).then(|| &meshes[self.rng.random_range(0..meshes.len())]);
+            let drawn = (spec.grains.shape == ShapeKind::Mesh).then(|| self.rng.random_range(0..meshes.len()));
+            let mesh = drawn.map(|k| &meshes[k]);
             let form = match (spec.grains.shape, spec.grains.form, &forms) {
                 (ShapeKind::Sphere, ..) => FormParameters { l: size, i: size, s: size },
                 (_, FormSpec::Single { fl, el }, _) => FormParameters::from_flatness_elongation(fl, el, size),
@@ -275,9 +288,11 @@ impl Packing {
                 (ShapeKind::BondedSpheres, _) => {
                     Shape::from(&bonded_grain(&form).map_err(|e| PackingError::Form(e.to_string()))?)
                 }
-                (ShapeKind::Mesh, Some(unit)) => Shape::Polyhedron(Box::new(
-                    Polyhedron::from_mesh(&unit.rescaled(&form)).map_err(|e| PackingError::Meshes(e.to_string()))?,
-                )),
+                (ShapeKind::Mesh, Some(_)) => {
+                    let base = self.bases[drawn.expect("a mesh was drawn")].clone();
+                    let grain = Polyhedron::with_form(base, &form).map_err(|e| PackingError::Meshes(e.to_string()))?;
+                    Shape::Polyhedron(Box::new(grain))
+                }
                 (ShapeKind::Mesh, None) => unreachable!("a mesh was drawn for a mesh packing"),
             };
             let orientation = uniform_rotation(&mut self.rng);

@@ -202,6 +202,13 @@ pub fn ellipsoid_ellipsoid_with_stats(
     (contact, stats)
 }
 
+/// The distance bound of a separating direction n (unit, from A towards B): the slab between the
+/// support planes h_A(n) and x_B − h_B(−n) along n, −f(n), is empty of both bodies.
+pub fn separation_gap(a: &EllipsoidPose, b: &EllipsoidPose, n: &Vector3<f64>) -> f64 {
+    let h = |e: &EllipsoidPose| n.dot(&(e.shape2 * n)).sqrt();
+    n.dot(&(b.center - a.center)) - (h(a) + h(b))
+}
+
 /// Contact of an ellipsoid (body A) with the plane through `plane_point` whose unit normal
 /// `plane_normal` points into the domain (body B is the wall behind it).
 ///

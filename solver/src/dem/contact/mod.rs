@@ -1,10 +1,28 @@
 //! Narrow phase: the exact contact geometry of two overlapping shapes, or of a shape and a wall.
+//!
+//! One module per algorithm: support functions ([`support`]), GJK ([`gjk`]), EPA ([`epa`]), the
+//! centre of pressure ([`centre_of_pressure`]) and frame coherence ([`coherence`]); the queries
+//! per pair of shapes in [`sphere`], [`ellipsoid`] and [`polyhedron`].
 
+pub mod centre_of_pressure;
+pub mod coherence;
 pub mod ellipsoid;
+pub(crate) mod epa;
+pub(crate) mod gjk;
+pub mod manifold;
 pub mod polyhedron;
 pub mod sphere;
+pub mod support;
 
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
+
+pub use self::coherence::PairCache;
+use self::ellipsoid::EllipsoidPose;
+pub use self::manifold::Manifold;
+use self::polyhedron::Apart;
+pub use self::polyhedron::Mode;
+use self::support::PolyhedronPose;
+use super::domain::Domain;
 
 /// Geometry of one contact, the same for both bodies of the pair.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -17,12 +35,6 @@ pub struct ContactGeometry {
     /// Penetration depth δ > 0: the minimum translational distance separating the bodies.
     pub depth: f64,
 }
-
-use nalgebra::Matrix3;
-
-use self::ellipsoid::EllipsoidPose;
-use self::polyhedron::PolyhedronPose;
-use super::domain::Domain;
 
 /// One convex piece of a body in the world, as the narrow phase meets it: the body itself for a
 /// sphere, an ellipsoid or a polyhedron, one component sphere of a bonded grain.
@@ -57,7 +69,16 @@ impl Piece<'_> {
         match *self {
             Piece::Sphere { radius, .. } => radius,
             Piece::Ellipsoid { pose, .. } => pose.smallest_semi_axis(),
-            Piece::Polyhedron(pose) => pose.shape().inner_radius(),
+            Piece::Polyhedron(pose) => pose.inner_radius(),
+        }
+    }
+
+    /// Radius of a sphere about the piece's centre that holds it.
+    pub fn bounding_radius(&self) -> f64 {
+        match *self {
+            Piece::Sphere { radius, .. } => radius,
+            Piece::Ellipsoid { pose, .. } => pose.bounding_radius(),
+            Piece::Polyhedron(pose) => pose.bounding_radius(),
         }
     }
 }
@@ -65,50 +86,97 @@ impl Piece<'_> {
 /// Contact of piece A with piece B. `warm` carries a direction from one step to the next: on
 /// entry the pair's last contact normal or separating direction (zero if none), on exit the
 /// one found now (zero if none), so that both touching and merely close pairs start warm.
+/// `cache` carries the rest of what the pair keeps ([`coherence`]); `travel` is the two
+/// bodies' travel sum now, recorded with a new distance bound. `mode` says whether the
+/// polyhedron shortcuts may be taken.
 #[inline(always)]
-pub fn between(a: &Piece, b: &Piece, warm: &mut Vector3<f64>) -> Option<ContactGeometry> {
+pub fn between(
+    a: &Piece,
+    b: &Piece,
+    warm: &mut Vector3<f64>,
+    cache: &mut PairCache,
+    travel: f64,
+    mode: Mode,
+) -> Option<ContactGeometry> {
     match (a, b) {
         (Piece::Sphere { center: ca, radius: ra }, Piece::Sphere { center: cb, radius: rb }) => {
             sphere::sphere_sphere(ca, *ra, cb, *rb)
         }
-        _ => curved(a, b, warm),
+        _ => curved(a, b, warm, cache, travel, mode),
     }
 }
 
 /// The non-spherical pairs, kept out of line so that the sphere path stays small.
 #[inline(never)]
-fn curved(a: &Piece, b: &Piece, warm: &mut Vector3<f64>) -> Option<ContactGeometry> {
+fn curved(
+    a: &Piece,
+    b: &Piece,
+    warm: &mut Vector3<f64>,
+    cache: &mut PairCache,
+    travel: f64,
+    mode: Mode,
+) -> Option<ContactGeometry> {
     let start = (*warm != Vector3::zeros()).then_some(*warm);
     let flip = |c: ContactGeometry| ContactGeometry { normal: -c.normal, ..c };
-    // Polyhedron queries find no separating direction to keep; the ellipsoid query does.
-    let (contact, separating) = match (a, b) {
+    let flip_apart = |a: Apart| Apart { direction: -a.direction, ..a };
+    let (contact, apart) = match (a, b) {
         (Piece::Polyhedron(pa), Piece::Polyhedron(pb)) => {
-            (polyhedron::polyhedron_polyhedron(pa, pb, start.as_ref()), None)
+            let (contact, apart, _) =
+                polyhedron::polyhedron_polyhedron_coherent(pa, pb, start.as_ref(), &mut cache.features, mode);
+            (contact, apart)
         }
-        (Piece::Polyhedron(p), Piece::Sphere { center, radius }) => {
-            (polyhedron::polyhedron_sphere(p, center, *radius), None)
-        }
+        (Piece::Polyhedron(p), Piece::Sphere { center, radius }) => polyhedron::polyhedron_sphere(p, center, *radius),
         (Piece::Sphere { center, radius }, Piece::Polyhedron(p)) => {
-            (polyhedron::polyhedron_sphere(p, center, *radius).map(flip), None)
+            let (contact, apart) = polyhedron::polyhedron_sphere(p, center, *radius);
+            (contact.map(flip), flip_apart(apart))
         }
-        (Piece::Polyhedron(p), other) => {
-            (polyhedron::polyhedron_ellipsoid(p, &other.ellipsoid(), start.as_ref()), None)
-        }
+        (Piece::Polyhedron(p), other) => polyhedron::polyhedron_ellipsoid(p, &other.ellipsoid(), start.as_ref()),
         (other, Piece::Polyhedron(p)) => {
-            (polyhedron::polyhedron_ellipsoid(p, &other.ellipsoid(), start.map(|n| -n).as_ref()).map(flip), None)
+            let (contact, apart) = polyhedron::polyhedron_ellipsoid(p, &other.ellipsoid(), start.map(|n| -n).as_ref());
+            (contact.map(flip), flip_apart(apart))
         }
         _ => {
-            let (contact, stats) =
-                ellipsoid::ellipsoid_ellipsoid_with_stats(&a.ellipsoid(), &b.ellipsoid(), start.as_ref());
-            (contact, stats.separating)
+            let (ea, eb) = (a.ellipsoid(), b.ellipsoid());
+            let (contact, stats) = ellipsoid::ellipsoid_ellipsoid_with_stats(&ea, &eb, start.as_ref());
+            let apart = stats
+                .separating
+                .map_or(Apart::default(), |n| Apart { gap: ellipsoid::separation_gap(&ea, &eb, &n), direction: n });
+            (contact, apart)
         }
     };
-    *warm = match (&contact, separating) {
-        (Some(c), _) => c.normal,
-        (None, Some(n)) => n,
-        (None, None) => Vector3::zeros(),
-    };
+    match &contact {
+        Some(c) => {
+            *warm = c.normal;
+            cache.gap = 0.0;
+        }
+        None => {
+            *warm = apart.direction;
+            cache.set_gap(apart.gap, travel, a.bounding_radius() + b.bounding_radius());
+        }
+    }
     contact
+}
+
+/// Contact of a piece with the floor z = 0, as a manifold: a polyhedron's face lying on the
+/// floor spreads over its corners, every other contact is one point.
+#[inline]
+pub fn with_floor_manifold(p: &Piece) -> Option<Manifold> {
+    match p {
+        Piece::Polyhedron(pose) => polyhedron::polyhedron_plane_manifold(pose, &Vector3::zeros(), &Vector3::z()),
+        _ => with_floor(p).map(Manifold::single),
+    }
+}
+
+/// Contact of a piece with the cylinder wall, if the domain has one, as a manifold.
+#[inline]
+pub fn with_wall_manifold(p: &Piece, domain: &Domain) -> Option<Manifold> {
+    match (p, domain) {
+        (Piece::Polyhedron(pose), Domain::Cylinder { diameter }) => {
+            let c = diameter / 2.0;
+            polyhedron::polyhedron_cylinder_wall_manifold(pose, c, c, c)
+        }
+        _ => with_wall(p, domain).map(Manifold::single),
+    }
 }
 
 /// Contact of a piece with the floor z = 0.

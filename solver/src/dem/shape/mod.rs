@@ -2,15 +2,21 @@
 //! in the body frame, whose axes are the principal axes of inertia; and the convex pieces the
 //! narrow phase meets (one for a convex grain, one per component sphere of a bonded grain).
 
-use nalgebra::{UnitQuaternion, Vector3};
+pub mod polyhedron;
+pub(crate) mod table;
+
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
+pub use self::polyhedron::{ConvexPolyhedron, Polyhedron, PolyhedronError};
 use super::contact::Piece;
 use super::contact::ellipsoid::EllipsoidPose;
-use super::contact::polyhedron::{ConvexPolyhedron, PolyhedronError, PolyhedronPose};
-use crate::grain::{BondedGrain, ComponentSphere, EquivalentEllipsoid, FormParameters, TriMesh};
+use super::contact::support::PolyhedronPose;
+use crate::grain::{BondedGrain, ComponentSphere, FormParameters};
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// A grain's shape. Polyhedra share their base mesh; a list of shapes is stored with each base
+/// mesh once (`table`).
+#[derive(Debug, Clone, PartialEq)]
 pub enum Shape {
     Sphere {
         radius: f64,
@@ -25,67 +31,6 @@ pub enum Shape {
     /// A convex polyhedron (a grain mesh, §3.1) in its principal-axes frame, centre of mass at
     /// the origin.
     Polyhedron(Box<Polyhedron>),
-}
-
-/// A convex polyhedron grain with its mass properties, precomputed once.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(try_from = "PolyhedronRecord", into = "PolyhedronRecord")]
-pub struct Polyhedron {
-    pub hull: ConvexPolyhedron,
-    pub volume: f64,
-    /// Principal moments per unit density along the body axes.
-    pub inertia: Vector3<f64>,
-    /// L, I, S of its mass-equivalent ellipsoid (Appendix A).
-    pub form: FormParameters,
-}
-
-impl Polyhedron {
-    /// A grain from a closed convex mesh given in its principal-axes frame (as
-    /// [`crate::grain::UnitMesh::rescaled`] gives it): mass properties from the mesh itself.
-    pub fn from_mesh(mesh: &TriMesh) -> Result<Self, PolyhedronError> {
-        let props = mesh.mass_properties();
-        let form = EquivalentEllipsoid::of(&props).form().map_err(|_| PolyhedronError::NotConvex)?;
-        Ok(Self { hull: ConvexPolyhedron::new(mesh)?, volume: props.volume, inertia: props.inertia.diagonal(), form })
-    }
-}
-
-impl PartialEq for Polyhedron {
-    fn eq(&self, other: &Self) -> bool {
-        self.hull.vertices() == other.hull.vertices() && self.hull.triangles() == other.hull.triangles()
-    }
-}
-
-/// What a checkpoint keeps of a polyhedron: the mesh and its mass properties; the narrow
-/// phase's tables are rebuilt from the mesh.
-#[derive(Serialize, Deserialize)]
-struct PolyhedronRecord {
-    vertices: Vec<Vector3<f64>>,
-    triangles: Vec<[u32; 3]>,
-    volume: f64,
-    inertia: Vector3<f64>,
-    form: FormParameters,
-}
-
-impl From<Polyhedron> for PolyhedronRecord {
-    fn from(p: Polyhedron) -> Self {
-        Self {
-            vertices: p.hull.vertices().to_vec(),
-            triangles: p.hull.triangles().to_vec(),
-            volume: p.volume,
-            inertia: p.inertia,
-            form: p.form,
-        }
-    }
-}
-
-impl TryFrom<PolyhedronRecord> for Polyhedron {
-    type Error = String;
-
-    fn try_from(r: PolyhedronRecord) -> Result<Self, String> {
-        let mesh = TriMesh::new(r.vertices, r.triangles).map_err(|e| format!("stored polyhedron: mesh {e}"))?;
-        let hull = ConvexPolyhedron::new(&mesh).map_err(|e| format!("stored polyhedron: {e}"))?;
-        Ok(Self { hull, volume: r.volume, inertia: r.inertia, form: r.form })
-    }
 }
 
 /// The component spheres of a bonded grain with its mass properties, precomputed once.
@@ -143,7 +88,7 @@ impl Shape {
             Shape::Sphere { radius } => *radius,
             Shape::Ellipsoid { semi_axes } => semi_axes.max(),
             Shape::Bonded(b) => b.bounding_radius,
-            Shape::Polyhedron(p) => p.hull.bounding_radius(),
+            Shape::Polyhedron(p) => p.bounding_radius,
         }
     }
 
@@ -160,6 +105,15 @@ impl Shape {
         }
     }
 
+    /// Bytes the shape holds outside its own enum (a polyhedron's shared base mesh excluded).
+    pub fn heap_bytes(&self) -> usize {
+        match self {
+            Shape::Sphere { .. } | Shape::Ellipsoid { .. } => 0,
+            Shape::Bonded(b) => std::mem::size_of::<Bonded>() + std::mem::size_of_val(&b.spheres[..]),
+            Shape::Polyhedron(_) => std::mem::size_of::<Polyhedron>(),
+        }
+    }
+
     /// Number of convex pieces the narrow phase meets.
     #[inline]
     pub fn pieces(&self) -> usize {
@@ -169,15 +123,15 @@ impl Shape {
         }
     }
 
-    /// Piece `k` of a body at `position` turned by `orientation` (with its ellipsoid `pose` for
-    /// an ellipsoid). Inline for the sphere, the rest out of line.
+    /// Piece `k` of a body at `position` turned by `orientation`, with the `pose` of this
+    /// step ([`Shape::pose`]). Inline for the sphere, the rest out of line.
     #[inline(always)]
     pub fn piece<'a>(
         &'a self,
         k: usize,
         position: Vector3<f64>,
         orientation: &UnitQuaternion<f64>,
-        pose: Option<&'a EllipsoidPose>,
+        pose: &'a Pose,
     ) -> Piece<'a> {
         match self {
             Shape::Sphere { radius } => Piece::Sphere { center: position, radius: *radius },
@@ -191,19 +145,19 @@ impl Shape {
         k: usize,
         position: Vector3<f64>,
         orientation: &UnitQuaternion<f64>,
-        pose: Option<&'a EllipsoidPose>,
+        pose: &'a Pose,
     ) -> Piece<'a> {
         match (self, pose) {
             (Shape::Sphere { .. }, _) => unreachable!("spheres are handled inline by `piece`"),
-            (Shape::Ellipsoid { .. }, Some(pose)) => Piece::Ellipsoid { pose, center: position },
-            (Shape::Ellipsoid { .. }, None) => unreachable!("an ellipsoid body always has a pose"),
+            (Shape::Ellipsoid { .. }, Pose::Ellipsoid(pose)) => Piece::Ellipsoid { pose, center: position },
             (Shape::Bonded(b), _) => {
                 let c = &b.spheres[k];
                 Piece::Sphere { center: position + orientation * c.center, radius: c.radius }
             }
-            (Shape::Polyhedron(p), _) => {
-                Piece::Polyhedron(PolyhedronPose::new(&p.hull, position, orientation.to_rotation_matrix().matrix()))
+            (Shape::Polyhedron(p), Pose::Polyhedron(frame)) => {
+                Piece::Polyhedron(PolyhedronPose::with_frame(p, frame, position))
             }
+            _ => unreachable!("a body's pose is made for its shape"),
         }
     }
 
@@ -225,7 +179,7 @@ impl Shape {
         match self {
             Shape::Sphere { radius } => (stretched(Vector3::repeat(*radius), Vector3::zeros()).collect(), triangles),
             Shape::Ellipsoid { semi_axes } => (stretched(*semi_axes, Vector3::zeros()).collect(), triangles),
-            Shape::Polyhedron(p) => (p.hull.vertices().to_vec(), p.hull.triangles().to_vec()),
+            Shape::Polyhedron(p) => p.surface(),
             Shape::Bonded(b) => {
                 let mut vertices = Vec::with_capacity(unit.len() * b.spheres.len());
                 let mut all = Vec::with_capacity(triangles.len() * b.spheres.len());
@@ -239,20 +193,51 @@ impl Shape {
         }
     }
 
-    /// The precomputed ellipsoid of the narrow phase for a body at `position` turned by
-    /// `orientation`; None for shapes met as spheres.
-    pub fn pose(&self, position: Vector3<f64>, orientation: &UnitQuaternion<f64>) -> Option<EllipsoidPose> {
+    /// What the narrow phase precomputes of a body at `position` turned by `orientation`, once
+    /// per step: nothing for shapes met as spheres.
+    pub fn pose(&self, position: Vector3<f64>, orientation: &UnitQuaternion<f64>) -> Pose {
         match self {
             Shape::Ellipsoid { semi_axes } => {
-                Some(EllipsoidPose::new(position, orientation.to_rotation_matrix().matrix(), *semi_axes))
+                Pose::Ellipsoid(EllipsoidPose::new(position, orientation.to_rotation_matrix().matrix(), *semi_axes))
             }
-            _ => None,
+            Shape::Polyhedron(p) => Pose::Polyhedron(PolyhedronFrame::new(orientation, &p.scale)),
+            Shape::Sphere { .. } | Shape::Bonded(_) => Pose::None,
         }
     }
 
     /// Radius of the sphere of equal volume (used by the porosity evaluation, §4.4).
     pub fn equivalent_radius(&self) -> f64 {
         (self.volume() * 3.0 / (4.0 * std::f64::consts::PI)).cbrt()
+    }
+}
+
+/// A body's shape turned into the world for one step, computed once per step.
+#[derive(Debug, Clone, Default)]
+pub enum Pose {
+    /// Spheres and bonded grains: the centre and orientation are all the narrow phase needs.
+    #[default]
+    None,
+    Ellipsoid(EllipsoidPose),
+    Polyhedron(PolyhedronFrame),
+}
+
+impl Pose {
+    pub fn is_some(&self) -> bool {
+        !matches!(self, Pose::None)
+    }
+}
+
+/// A stretched polyhedron's body-to-world maps: vertices x = R S v, face normals ∝ R S⁻¹ n.
+#[derive(Debug, Clone, Copy)]
+pub struct PolyhedronFrame {
+    pub map: Matrix3<f64>,
+    pub normal_map: Matrix3<f64>,
+}
+
+impl PolyhedronFrame {
+    pub fn new(orientation: &UnitQuaternion<f64>, scale: &Vector3<f64>) -> Self {
+        let r = orientation.to_rotation_matrix().into_inner();
+        Self { map: r * Matrix3::from_diagonal(scale), normal_map: r * Matrix3::from_diagonal(&scale.map(|s| 1.0 / s)) }
     }
 }
 
