@@ -23,6 +23,8 @@ pub enum CvError {
     },
     #[error("porosity is the same for every row, so R² is undefined")]
     ConstantPorosity,
+    #[error("{folds} fold ids for {rows} rows: expected one per row")]
+    FoldCount { folds: usize, rows: usize },
 }
 
 /// Held-out metrics and each row's held-out prediction.
@@ -48,7 +50,9 @@ pub fn assign_folds(rows: usize, k: usize, seed: u64) -> Vec<usize> {
 /// Cross-validates the least-squares model of `y` on the named columns over the given fold of
 /// each row (fold ids 0, 1, …; the number of folds is the number of distinct ids).
 pub fn cross_validate(names: &[String], columns: &[&[f64]], y: &[f64], folds: &[usize]) -> Result<CvOutcome, CvError> {
-    assert_eq!(folds.len(), y.len(), "one fold id per row");
+    if folds.len() != y.len() {
+        return Err(CvError::FoldCount { folds: folds.len(), rows: y.len() });
+    }
     let mut ids: Vec<usize> = folds.to_vec();
     ids.sort_unstable();
     ids.dedup();
@@ -100,5 +104,12 @@ mod tests {
         let mut ids = capped.clone();
         ids.sort_unstable();
         assert_eq!(ids, [0, 1, 2, 3], "k capped at the rows: leave-one-out");
+    }
+
+    #[test]
+    fn fold_ids_that_do_not_match_the_rows_are_an_error() {
+        let x = [1.0, 2.0, 3.0];
+        let outcome = cross_validate(&["x".into()], &[&x], &[0.3, 0.4, 0.5], &[0, 1]);
+        assert_eq!(outcome, Err(CvError::FoldCount { folds: 2, rows: 3 }));
     }
 }

@@ -9,6 +9,7 @@ use std::fmt::Write as _;
 use serde::Serialize;
 use thiserror::Error;
 
+use crate::csv;
 use crate::form_factors::{form_feature_names, inverse_name};
 use crate::record::JobRecord;
 
@@ -327,7 +328,7 @@ impl Dataset {
         }
         out.push('\n');
         for (row, id) in self.job_ids.iter().enumerate() {
-            out.push_str(&csv_field(id));
+            out.push_str(&csv::field(id));
             let _ = write!(out, ",{}", self.porosity[row]);
             for c in &self.columns {
                 let _ = write!(out, ",{}", c[row]);
@@ -336,11 +337,6 @@ impl Dataset {
         }
         out
     }
-}
-
-/// Quotes a CSV field when it holds a separator, quote or line break (RFC 4180).
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s.to_string() }
 }
 
 #[cfg(test)]
@@ -368,12 +364,5 @@ mod tests {
         for paper in ["inv_mean_EQ", "inv_std_EQ", "inv_mean_EL", "inv_std_EL"] {
             assert!(names.iter().any(|n| n == paper), "{paper}");
         }
-    }
-
-    #[test]
-    fn csv_quotes_awkward_ids() {
-        assert_eq!(csv_field("a,b"), "\"a,b\"");
-        assert_eq!(csv_field("say \"hi\""), "\"say \"\"hi\"\"\"");
-        assert_eq!(csv_field("plain"), "plain");
     }
 }

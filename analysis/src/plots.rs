@@ -4,13 +4,14 @@
 //! renders them with whatever sans-serif font it has.
 
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
+use solver::porosity::ProfilePoint;
 use thiserror::Error;
 
 use crate::correlation::CorrelationMatrix;
 use crate::form_factors::symbol;
-use crate::record::ProfilePoint;
 
 #[derive(Debug, Error, PartialEq)]
 #[error("drawing the {figure}: {message}")]
@@ -20,6 +21,7 @@ pub struct PlotError {
 }
 
 type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+type Chart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 type Drawn = Result<(), DrawingAreaErrorKind<std::io::Error>>;
 
 const FONT: &str = "sans-serif";
@@ -35,6 +37,48 @@ fn render(figure: &'static str, size: (u32, u32), draw: impl FnOnce(&Area) -> Dr
         result.map_err(|e| PlotError { figure, message: e.to_string() })?;
     }
     Ok(svg)
+}
+
+/// A chart over x and y with the report's margins and a caption of `size` points.
+fn chart<'a, 'b>(
+    area: &'a Area<'b>,
+    caption: &str,
+    size: u32,
+    x: (f64, f64),
+    y: (f64, f64),
+) -> Result<Chart<'a, 'b>, DrawingAreaErrorKind<std::io::Error>> {
+    ChartBuilder::on(area)
+        .caption(caption, (FONT, size))
+        .margin(15)
+        .x_label_area_size(50)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x.0..x.1, y.0..y.1)
+}
+
+/// Axes in the report's style: described, ticks with as many decimals as the ranges need, a
+/// white grid.
+fn axes(chart: &mut Chart, x_desc: &str, y_desc: &str, x: (f64, f64), y: (f64, f64)) -> Drawn {
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .label_style((FONT, 13))
+        .axis_desc_style((FONT, 15))
+        .x_label_formatter(&|v| format!("{v:.*}", decimals(x)))
+        .y_label_formatter(&|v| format!("{v:.*}", decimals(y)))
+        .light_line_style(WHITE)
+        .draw()
+}
+
+/// The series' legend in the upper left, on a translucent white box.
+fn legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, font: u32) -> Drawn {
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .label_font((FONT, font))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK.mix(0.4))
+        .draw()
 }
 
 /// [min, max] of finite values widened by 5 % (or ±0.5 % of the value for a single value),
@@ -136,22 +180,8 @@ pub fn scatter(plot: &ScatterPlot) -> Result<String, PlotError> {
     render("scatter plot", (640, 480), |root| {
         let x = padded_range(plot.points.iter().map(|p| p.0));
         let y = padded_range(plot.points.iter().map(|p| p.1));
-        let mut chart = ChartBuilder::on(root)
-            .caption(plot.title, (FONT, 19))
-            .margin(15)
-            .x_label_area_size(50)
-            .y_label_area_size(70)
-            .build_cartesian_2d(x.0..x.1, y.0..y.1)?;
-        chart
-            .configure_mesh()
-            .x_desc(plot.x_label)
-            .y_desc(plot.y_label)
-            .label_style((FONT, 13))
-            .axis_desc_style((FONT, 15))
-            .x_label_formatter(&|v| format!("{v:.*}", decimals(x)))
-            .y_label_formatter(&|v| format!("{v:.*}", decimals(y)))
-            .light_line_style(WHITE)
-            .draw()?;
+        let mut chart = chart(root, plot.title, 19, x, y)?;
+        axes(&mut chart, plot.x_label, plot.y_label, x, y)?;
         chart
             .draw_series(plot.points.iter().map(|&p| Circle::new(p, 4, STEEL.filled())))?
             .label("packings")
@@ -163,13 +193,7 @@ pub fn scatter(plot: &ScatterPlot) -> Result<String, PlotError> {
                 .label(legend.as_str())
                 .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], RED.stroke_width(2)));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .label_font((FONT, 13))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.4))
-            .draw()
+        legend(&mut chart, 13)
     })
 }
 
@@ -183,22 +207,8 @@ pub fn predicted_vs_observed(
 ) -> Result<String, PlotError> {
     render("predicted-versus-observed plot", (560, 540), |root| {
         let (lo, hi) = padded_range(observed.iter().chain(fitted).chain(held_out).copied());
-        let mut chart = ChartBuilder::on(root)
-            .caption(title, (FONT, 18))
-            .margin(15)
-            .x_label_area_size(50)
-            .y_label_area_size(70)
-            .build_cartesian_2d(lo..hi, lo..hi)?;
-        chart
-            .configure_mesh()
-            .x_desc("observed porosity n (–)")
-            .y_desc("predicted porosity n (–)")
-            .label_style((FONT, 13))
-            .axis_desc_style((FONT, 15))
-            .x_label_formatter(&|v| format!("{v:.*}", decimals((lo, hi))))
-            .y_label_formatter(&|v| format!("{v:.*}", decimals((lo, hi))))
-            .light_line_style(WHITE)
-            .draw()?;
+        let mut chart = chart(root, title, 18, (lo, hi), (lo, hi))?;
+        axes(&mut chart, "observed porosity n (–)", "predicted porosity n (–)", (lo, hi), (lo, hi))?;
         chart
             .draw_series(LineSeries::new([(lo, lo), (hi, hi)], BLACK.stroke_width(1)))?
             .label("perfect agreement")
@@ -211,13 +221,7 @@ pub fn predicted_vs_observed(
             .draw_series(observed.iter().zip(fitted).map(|(&o, &p)| Circle::new((o, p), 3, STEEL.filled())))?
             .label("fitted on all packings")
             .legend(|(x, y)| Circle::new((x + 7, y), 3, STEEL.filled()));
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .label_font((FONT, 13))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.4))
-            .draw()
+        legend(&mut chart, 13)
     })
 }
 
@@ -282,41 +286,22 @@ pub fn heat_map(title: &str, matrix: &CorrelationMatrix) -> Result<String, PlotE
 pub fn profiles(profiles: &[(String, Vec<ProfilePoint>)]) -> Result<String, PlotError> {
     render("porosity profiles", (640, 520), |root| {
         let top = padded_range(profiles.iter().flat_map(|(_, p)| p.iter().map(|q| q.z))).1.max(1e-3);
-        let mut chart = ChartBuilder::on(root)
-            .caption("Porosity profiles n(z)", (FONT, 19))
-            .margin(15)
-            .x_label_area_size(50)
-            .y_label_area_size(70)
-            .build_cartesian_2d(0f64..1f64, 0f64..top)?;
-        chart
-            .configure_mesh()
-            .x_desc("slice porosity n (–)")
-            .y_desc("height z (m)")
-            .label_style((FONT, 13))
-            .axis_desc_style((FONT, 15))
-            .y_label_formatter(&|v| format!("{v:.*}", decimals((0.0, top))))
-            .light_line_style(WHITE)
-            .draw()?;
+        let mut chart = chart(root, "Porosity profiles n(z)", 19, (0.0, 1.0), (0.0, top))?;
+        axes(&mut chart, "slice porosity n (–)", "height z (m)", (0.0, 1.0), (0.0, top))?;
         // A legend for a handful of packings helps; for a campaign it would hide the plot.
-        let legend = profiles.len() <= 8;
+        let with_legend = profiles.len() <= 8;
         for (k, (label, points)) in profiles.iter().enumerate() {
             let colour = Palette99::pick(k).to_rgba();
             let series =
                 chart.draw_series(LineSeries::new(points.iter().map(|p| (p.n, p.z)), colour.stroke_width(1)))?;
-            if legend {
+            if with_legend {
                 series
                     .label(label.as_str())
                     .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], colour.stroke_width(2)));
             }
         }
-        if legend {
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperLeft)
-                .label_font((FONT, 12))
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK.mix(0.4))
-                .draw()?;
+        if with_legend {
+            legend(&mut chart, 12)?;
         }
         Ok(())
     })

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 use thiserror::Error;
 
+use crate::csv::{CsvError, read_columns};
 use crate::dataset::{
     DroppedFeature, is_single_form_statistics, mixture_feature_names, mixture_features, single_form_features,
 };
@@ -28,8 +29,8 @@ pub enum PredictionError {
     Parse { path: PathBuf, message: String },
     #[error("{path}: key '{key}': {message}")]
     InvalidModel { path: PathBuf, key: String, message: String },
-    #[error("{path}, line {line}: {message}")]
-    Csv { path: PathBuf, line: usize, message: String },
+    #[error(transparent)]
+    Csv(#[from] CsvError),
     #[error("{0}")]
     InvalidInput(String),
     #[error("model '{model}' needs feature '{feature}', which {input} cannot give: {why}")]
@@ -182,39 +183,18 @@ pub fn input_from_grains(grains: &[(f64, f64)], description: &str) -> Result<Mod
 /// (FL, EL) pairs from a CSV whose header names columns FL and EL (any case, any order, other
 /// columns ignored); blank lines and lines starting with '#' are skipped.
 pub fn read_grains_csv(path: &Path) -> Result<Vec<(f64, f64)>, PredictionError> {
-    let text = std::fs::read_to_string(path).map_err(|source| PredictionError::Read { path: path.into(), source })?;
-    let csv_error = |line: usize, message: String| PredictionError::Csv { path: path.into(), line, message };
-    let mut lines =
-        text.lines().enumerate().map(|(k, l)| (k + 1, l.trim())).filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let (header_line, header) =
-        lines.next().ok_or_else(|| csv_error(1, "empty file: expected a header with columns FL and EL".into()))?;
-    let names: Vec<String> = header.split(',').map(|h| h.trim().trim_matches('"').to_ascii_uppercase()).collect();
-    let column = |want: &str| {
-        names
-            .iter()
-            .position(|n| n == want)
-            .ok_or_else(|| csv_error(header_line, format!("no column '{want}' in header '{header}'")))
-    };
-    let (fl_at, el_at) = (column("FL")?, column("EL")?);
-    let mut grains = Vec::new();
-    for (line, row) in lines {
-        let cells: Vec<&str> = row.split(',').map(str::trim).collect();
-        let value = |at: usize, name: &str| -> Result<f64, PredictionError> {
-            let cell = cells.get(at).ok_or_else(|| csv_error(line, format!("no value in column '{name}'")))?;
-            let v: f64 =
-                cell.parse().map_err(|_| csv_error(line, format!("column '{name}': '{cell}' is not a number")))?;
-            if v > 0.0 && v <= 1.0 {
-                Ok(v)
-            } else {
-                Err(csv_error(line, format!("column '{name}': {v} is outside (0, 1]")))
+    read_columns(path, &["FL", "EL"])?
+        .into_iter()
+        .map(|(line, values)| {
+            for (name, v) in ["FL", "EL"].iter().zip(&values) {
+                if !(*v > 0.0 && *v <= 1.0) {
+                    let message = format!("column '{name}': {v} is outside (0, 1]");
+                    return Err(CsvError::Line { path: path.into(), line, message }.into());
+                }
             }
-        };
-        grains.push((value(fl_at, "FL")?, value(el_at, "EL")?));
-    }
-    if grains.is_empty() {
-        return Err(csv_error(header_line, "no grains below the header".into()));
-    }
-    Ok(grains)
+            Ok((values[0], values[1]))
+        })
+        .collect()
 }
 
 /// The model's porosity for an input, with a warning for every feature outside the training

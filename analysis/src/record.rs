@@ -1,17 +1,18 @@
 //! What the analysis reads: one plain record per finished job and a campaign summary. The
-//! pipeline maps store rows into these; the analysis never sees solver or SQLite types.
+//! pipeline maps store rows into these; the analysis never sees SQLite types, and of the solver
+//! only the porosity profile's points.
 
 use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
+use solver::porosity::ProfilePoint;
 
-/// One slice of a porosity profile.
+/// A measured porosity to compare the simulated one with (Table 6).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct ProfilePoint {
-    /// Slice centre, m.
-    pub z: f64,
-    /// Porosity of the slice.
-    pub n: f64,
+pub struct Experiment {
+    pub porosity: f64,
+    /// Standard deviation of the measurement; None when the source does not give it.
+    pub std: Option<f64>,
 }
 
 /// A finished packing job.
@@ -25,8 +26,8 @@ pub struct JobRecord {
     pub parameters: BTreeMap<String, serde_json::Value>,
     /// "FL", "inv_FL", …, "WFI", "inv_WFI" → (number-based mean, std) over the packing's grains.
     pub grain_statistics: BTreeMap<String, (f64, f64)>,
-    /// Measured porosity and its standard deviation, when the campaign gives one.
-    pub experiment: Option<(f64, f64)>,
+    /// Measured porosity, when the campaign gives one.
+    pub experiment: Option<Experiment>,
 }
 
 /// The campaign as a whole, for the report header.

@@ -37,7 +37,7 @@ impl Default for SelectionOptions {
     }
 }
 
-#[derive(Debug, Error, PartialEq)]
+#[derive(Debug, Clone, Error, PartialEq)]
 pub enum SelectionError {
     #[error("threshold {0} must lie in (0, 1]")]
     Threshold(f64),
@@ -49,6 +49,8 @@ pub enum SelectionError {
     ConstantPorosity,
     #[error("no feature varies across the jobs, so none can be correlated with porosity")]
     NoRankableFeature,
+    #[error("feature '{0}' is not a column of the dataset")]
+    UnknownFeature(String),
 }
 
 #[derive(Debug, Error, PartialEq)]
@@ -128,8 +130,13 @@ impl Selection {
 
 /// Features of `candidates` whose |r| with `primary` exceeds `threshold` are removed; the rest
 /// are kept. Both lists carry the r with the primary.
-pub fn filter_correlated(dataset: &Dataset, primary: &str, candidates: &[String], threshold: f64) -> CorrelationFilter {
-    let p = dataset.column(primary).expect("the primary is a dataset column");
+pub fn filter_correlated(
+    dataset: &Dataset,
+    primary: &str,
+    candidates: &[String],
+    threshold: f64,
+) -> Result<CorrelationFilter, SelectionError> {
+    let p = dataset.column(primary).ok_or_else(|| SelectionError::UnknownFeature(primary.to_string()))?;
     let (mut removed, mut kept) = (Vec::new(), Vec::new());
     for f in candidates.iter().filter(|f| f.as_str() != primary) {
         let Some(column) = dataset.column(f) else { continue };
@@ -137,7 +144,7 @@ pub fn filter_correlated(dataset: &Dataset, primary: &str, candidates: &[String]
         let entry = FeatureCorrelation { feature: f.clone(), r };
         if r.abs() > threshold { removed.push(entry) } else { kept.push(entry) }
     }
-    CorrelationFilter { threshold, removed, kept }
+    Ok(CorrelationFilter { threshold, removed, kept })
 }
 
 /// Cross-validates the model of porosity on `features` over `folds`, then fits it on all rows;
@@ -229,7 +236,7 @@ pub fn select_models(
     let primary = ranking.primary(dataset).ok_or(SelectionError::NoRankableFeature)?.clone();
     let p = primary.feature.clone();
     let ranked: Vec<String> = ranking.ranked.iter().map(|c| c.feature.clone()).collect();
-    let filter = filter_correlated(dataset, &p, &ranked, options.threshold);
+    let filter = filter_correlated(dataset, &p, &ranked, options.threshold)?;
 
     let mut pairs = vec![candidate(dataset, vec![p.clone()], &folds, campaign)];
     pairs.extend(filter.kept.iter().map(|k| candidate(dataset, vec![p.clone(), k.feature.clone()], &folds, campaign)));

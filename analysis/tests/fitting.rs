@@ -145,7 +145,7 @@ fn the_filter_removes_exactly_the_features_above_the_threshold() {
     let dataset = Dataset::from_columns(FeatureKind::SingleForm, ids, porosity, columns).unwrap();
     let ranking = rank_features(&dataset);
     assert_eq!(ranking.primary(&dataset).unwrap().feature, "primary");
-    let filter = filter_correlated(&dataset, "primary", dataset.features(), 0.8);
+    let filter = filter_correlated(&dataset, "primary", dataset.features(), 0.8).unwrap();
     let removed: Vec<&str> = filter.removed.iter().map(|c| c.feature.as_str()).collect();
     let kept: Vec<&str> = filter.kept.iter().map(|c| c.feature.as_str()).collect();
     assert_eq!(removed, ["near", "opposite"]);
@@ -156,6 +156,9 @@ fn the_filter_removes_exactly_the_features_above_the_threshold() {
     let mut removed_by_procedure: Vec<&str> = selection.filter.removed.iter().map(|c| c.feature.as_str()).collect();
     removed_by_procedure.sort_unstable();
     assert_eq!(removed_by_procedure, ["near", "opposite"]);
+    // A primary that is not a column is an error, not a panic.
+    let unknown = filter_correlated(&dataset, "nowhere", dataset.features(), 0.8).unwrap_err();
+    assert!(unknown.to_string().contains("'nowhere'"), "{unknown}");
 }
 
 #[test]

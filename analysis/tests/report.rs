@@ -4,15 +4,17 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use analysis::analyse;
 use analysis::dataset::mixture_feature_names;
 use analysis::form_factors::{form_feature_names, grain_statistics};
 use analysis::model::LinearModel;
-use analysis::record::{CampaignSummary, JobRecord, ProfilePoint};
-use analysis::report::write_report;
+use analysis::record::{CampaignSummary, Experiment, JobRecord};
+use analysis::report::{ReportFiles, write_report};
 use analysis::selection::SelectionOptions;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde_json::json;
+use solver::porosity::ProfilePoint;
 
 /// Grains of a packing: FL and EL on a 4 × 4 grid at μ ± 0.5σ, ± 1.5σ, clipped to [0.1, 1]
 /// like the sampler's redrawing range.
@@ -80,6 +82,12 @@ fn summary(name: &str, done: usize) -> CampaignSummary {
     CampaignSummary { name: name.into(), pending: 0, running: 0, done, failed: 1, total_runtime: 7384.0 }
 }
 
+/// The analysis of the records with the default options, and its report in `out`.
+fn report(name: &str, records: &[JobRecord], out: &Path) -> ReportFiles {
+    let analysis = analyse(records, name, &SelectionOptions::default()).unwrap();
+    write_report(&summary(name, records.len()), records, &analysis, out).unwrap()
+}
+
 /// Two-pass Pearson, independent of the library.
 fn pearson(x: &[f64], y: &[f64]) -> f64 {
     let n = x.len() as f64;
@@ -138,9 +146,7 @@ fn check_html(out: &Path, min_svgs: usize) -> String {
 fn a_mixture_campaign_report_recovers_the_planted_model() {
     let records = mixture_campaign();
     let out = tempfile::tempdir().unwrap();
-    let files =
-        write_report(&summary("synthetic-fm", records.len()), &records, &SelectionOptions::default(), out.path())
-            .unwrap();
+    let files = report("synthetic-fm", &records, out.path());
 
     // dataset.csv: the header is job_id, porosity, then mixture features in their order.
     let (header, rows) = read_csv(&files.dataset);
@@ -203,6 +209,13 @@ fn a_mixture_campaign_report_recovers_the_planted_model() {
 
     let html = check_html(out.path(), 5);
     assert!(html.contains("Zingg diagram") && html.contains("Porosity profiles n(z)"));
+    // The ranking of every feature folds away; the short campaign table does not.
+    let ranked = header.len() - 2;
+    assert!(html.contains(&format!("<details>\n<summary>Show the {ranked} rows of this table</summary>")), "{html}");
+    let campaign_table = html.find("<table>").unwrap();
+    assert!(!html[..campaign_table].contains("<details>"));
+    // 36 packings are enough for the four features fitted: no caution.
+    assert!(!md.contains("Too few packings"));
     assert!(html.contains("elongation EL = I/L (–)"), "axis labels with units are text elements");
     assert_eq!(files.figures.len(), 5, "Zingg, profiles, primary, correlation, predicted vs observed");
 }
@@ -211,8 +224,8 @@ fn a_mixture_campaign_report_recovers_the_planted_model() {
 fn validation_campaign() -> Vec<JobRecord> {
     let mut records = Vec::new();
     let cases = [
-        ("U1", [0.382, 0.381, 0.386], (0.371, 0.001), (0.6, 0.7)),
-        ("U3", [0.367, 0.369, 0.372], (0.356, 0.003), (0.5, 0.8)),
+        ("U1", [0.382, 0.381, 0.386], Experiment { porosity: 0.371, std: Some(0.001) }, (0.6, 0.7)),
+        ("U3", [0.367, 0.369, 0.372], Experiment { porosity: 0.356, std: Some(0.003) }, (0.5, 0.8)),
     ];
     for (case, runs, experiment, (fl, el)) in cases {
         for (seed, n) in runs.iter().enumerate() {
@@ -233,7 +246,7 @@ fn validation_campaign() -> Vec<JobRecord> {
 fn a_single_form_validation_report_has_table_6() {
     let records = validation_campaign();
     let out = tempfile::tempdir().unwrap();
-    let files = write_report(&summary("validation", 6), &records, &SelectionOptions::default(), out.path()).unwrap();
+    let files = report("validation", &records, out.path());
     let md = std::fs::read_to_string(&files.markdown).unwrap();
     // Table 6, U1: mean 0.383 ± 0.002 (population std), 0.383 − 0.371 = 0.012, 3.23 %;
     // U3: 0.369 ± 0.002, 0.369333 − 0.356 = 0.013, 3.75 %.
@@ -253,15 +266,40 @@ fn a_single_form_validation_report_has_table_6() {
 }
 
 #[test]
+fn a_model_fitted_to_few_packings_comes_with_a_plain_warning() {
+    let records: Vec<JobRecord> = mixture_campaign().into_iter().step_by(4).take(8).collect();
+    let out = tempfile::tempdir().unwrap();
+    let files = report("few", &records, out.path());
+    let md = std::fs::read_to_string(&files.markdown).unwrap();
+    let chosen = md.find("### Chosen model").expect("a model is chosen");
+    let warning = md.find("**Too few packings for this model:** 8 packings for").expect(&md);
+    assert!(warning > chosen && md[chosen..warning].matches("\n\n").count() == 2, "right after the choice: {md}");
+    assert!(md[warning..].contains("Run more packings before relying on it."));
+}
+
+#[test]
+fn a_measurement_without_its_spread_is_shown_without_one() {
+    let mut records = validation_campaign();
+    for r in &mut records[3..] {
+        r.experiment = Some(Experiment { porosity: 0.356, std: None });
+    }
+    let out = tempfile::tempdir().unwrap();
+    let files = report("validation", &records, out.path());
+    let md = std::fs::read_to_string(&files.markdown).unwrap();
+    assert!(md.contains("| 0.369 ± 0.002 | 0.356 (spread not given) | 0.013 |"), "{md}");
+    assert!(md.contains("| 0.371 ± 0.001 |") && !md.contains("± 0.000"), "{md}");
+}
+
+#[test]
 fn too_few_packings_still_give_a_report_that_says_why() {
     let records: Vec<JobRecord> = validation_campaign().into_iter().take(2).collect();
     let out = tempfile::tempdir().unwrap();
-    let files = write_report(&summary("tiny", 2), &records, &SelectionOptions::default(), out.path()).unwrap();
+    let files = report("tiny", &records, out.path());
     let md = std::fs::read_to_string(&files.markdown).unwrap();
     assert!(md.contains("No model could be built: 2 finished jobs are too few"), "{md}");
     assert!(files.models.is_empty());
     check_html(out.path(), 1);
 
-    let empty = write_report(&summary("empty", 0), &[], &SelectionOptions::default(), out.path()).unwrap();
+    let empty = report("empty", &[], out.path());
     assert_eq!(std::fs::read_to_string(empty.dataset).unwrap(), "job_id,porosity\n");
 }

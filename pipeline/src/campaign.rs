@@ -10,7 +10,9 @@ use serde_json::{Map, Value as Json};
 use serde_norway::{Mapping, Value};
 use sha2::{Digest, Sha256};
 
-use crate::spec::{JobSpec, Source, parse_job_value, read_yaml, resolve};
+use crate::job_file::{Source, parse_job_value, read_yaml};
+use crate::spec::{JobSpec, resolve};
+use crate::stored;
 
 #[derive(Debug, Clone)]
 pub struct Campaign {
@@ -28,10 +30,10 @@ pub struct PlannedJob {
     pub parameters: Map<String, Json>,
 }
 
-/// Stable id of a resolved job: the first 16 hex digits of the SHA-256 of its canonical JSON
+/// Stable id of a resolved job: the first 16 hex digits of the SHA-256 of its stored JSON
 /// (which includes the campaign name, so ids never collide across campaigns).
 pub fn job_id(spec: &JobSpec) -> String {
-    let digest = Sha256::digest(spec.canonical_json().as_bytes());
+    let digest = Sha256::digest(stored::canonical_json(spec).as_bytes());
     digest.iter().take(8).map(|b| format!("{b:02x}")).collect()
 }
 

@@ -214,6 +214,32 @@ pub struct DistributionArgs {
     pub sigma_el: f64,
 }
 
+/// A form distribution given on the command line beside other inputs: all four parameters or none.
+#[derive(Debug, Clone, Args)]
+pub struct OptionalDistributionArgs {
+    /// Mean flatness μ_FL of a form distribution (with --sigma-fl, --mu-el, --sigma-el).
+    #[arg(long, allow_negative_numbers = true, requires_all = ["sigma_fl", "mu_el", "sigma_el"])]
+    pub mu_fl: Option<f64>,
+    #[arg(long, allow_negative_numbers = true, requires = "mu_fl")]
+    pub sigma_fl: Option<f64>,
+    #[arg(long, allow_negative_numbers = true, requires = "mu_fl")]
+    pub mu_el: Option<f64>,
+    #[arg(long, allow_negative_numbers = true, requires = "mu_fl")]
+    pub sigma_el: Option<f64>,
+}
+
+impl OptionalDistributionArgs {
+    /// The distribution, if given (clap makes it all four or none).
+    pub fn given(&self) -> Option<DistributionArgs> {
+        Some(DistributionArgs {
+            mu_fl: self.mu_fl?,
+            sigma_fl: self.sigma_fl?,
+            mu_el: self.mu_el?,
+            sigma_el: self.sigma_el?,
+        })
+    }
+}
+
 #[derive(Debug, Args)]
 #[command(group(ArgGroup::new("input").required(true).args(["lis", "mesh", "mu_fl", "bonded"])))]
 pub struct FormsArgs {
@@ -231,15 +257,8 @@ pub struct FormsArgs {
     /// spheres and mass properties beside those of the ellipsoid with the same axes.
     #[arg(long, num_args = 3, value_names = ["L", "I", "S"], allow_negative_numbers = true)]
     pub bonded: Option<Vec<f64>>,
-    /// Mean flatness μ_FL of a form distribution (with --sigma-fl, --mu-el, --sigma-el).
-    #[arg(long, allow_negative_numbers = true, requires_all = ["sigma_fl", "mu_el", "sigma_el"])]
-    pub mu_fl: Option<f64>,
-    #[arg(long, allow_negative_numbers = true, requires = "mu_fl")]
-    pub sigma_fl: Option<f64>,
-    #[arg(long, allow_negative_numbers = true, requires = "mu_fl")]
-    pub mu_el: Option<f64>,
-    #[arg(long, allow_negative_numbers = true, requires = "mu_fl")]
-    pub sigma_el: Option<f64>,
+    #[command(flatten)]
+    pub distribution: OptionalDistributionArgs,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -253,10 +272,9 @@ pub enum SampleCommand {
     Sizes(SampleSizesArgs),
 }
 
+/// How many grains `sample` draws, from which seed, and how it prints them.
 #[derive(Debug, Args)]
-pub struct SampleFormsArgs {
-    #[command(flatten)]
-    pub distribution: DistributionArgs,
+pub struct DrawArgs {
     /// Number of grains to draw.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub count: u64,
@@ -268,6 +286,14 @@ pub struct SampleFormsArgs {
 }
 
 #[derive(Debug, Args)]
+pub struct SampleFormsArgs {
+    #[command(flatten)]
+    pub distribution: DistributionArgs,
+    #[command(flatten)]
+    pub draw: DrawArgs,
+}
+
+#[derive(Debug, Args)]
 #[command(group(ArgGroup::new("curve").required(true).args(["case", "sieves"])))]
 pub struct SampleSizesArgs {
     /// A size case of Table 3: U1, U3, U5, U7, B30, B50, B70.
@@ -276,13 +302,8 @@ pub struct SampleSizesArgs {
     /// A sieve-curve file (YAML or JSON): {sieves: [m, …], fractions: [mass fraction per class]}.
     #[arg(long)]
     pub sieves: Option<PathBuf>,
-    /// Number of grains to draw.
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
-    pub count: u64,
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
-    #[arg(long)]
-    pub json: bool,
+    #[command(flatten)]
+    pub draw: DrawArgs,
 }
 
 #[derive(Debug, Args)]
@@ -293,14 +314,8 @@ pub struct PredictArgs {
     /// paper-sf-B50 (single form, Eqs. 17–19).
     #[arg(long)]
     pub model: String,
-    #[arg(long, allow_negative_numbers = true, requires_all = ["sigma_fl", "mu_el", "sigma_el"])]
-    pub mu_fl: Option<f64>,
-    #[arg(long, allow_negative_numbers = true, requires = "mu_fl")]
-    pub sigma_fl: Option<f64>,
-    #[arg(long, allow_negative_numbers = true, requires = "mu_fl")]
-    pub mu_el: Option<f64>,
-    #[arg(long, allow_negative_numbers = true, requires = "mu_fl")]
-    pub sigma_el: Option<f64>,
+    #[command(flatten)]
+    pub distribution: OptionalDistributionArgs,
     /// Flatness FL = S/I of a single form, in (0, 1].
     #[arg(long, allow_negative_numbers = true, requires = "el")]
     pub fl: Option<f64>,
@@ -312,25 +327,4 @@ pub struct PredictArgs {
     pub grains: Option<PathBuf>,
     #[arg(long)]
     pub json: bool,
-}
-
-impl FormsArgs {
-    pub fn distribution(&self) -> Option<DistributionArgs> {
-        distribution(self.mu_fl, self.sigma_fl, self.mu_el, self.sigma_el)
-    }
-}
-
-impl PredictArgs {
-    pub fn distribution(&self) -> Option<DistributionArgs> {
-        distribution(self.mu_fl, self.sigma_fl, self.mu_el, self.sigma_el)
-    }
-}
-
-fn distribution(
-    mu_fl: Option<f64>,
-    sigma_fl: Option<f64>,
-    mu_el: Option<f64>,
-    sigma_el: Option<f64>,
-) -> Option<DistributionArgs> {
-    Some(DistributionArgs { mu_fl: mu_fl?, sigma_fl: sigma_fl?, mu_el: mu_el?, sigma_el: sigma_el? })
 }

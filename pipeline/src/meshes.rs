@@ -8,7 +8,7 @@ use std::path::Path;
 use anyhow::{Context, anyhow};
 use sha2::{Digest, Sha256};
 use solver::grain::pebble::pebble_library;
-use solver::grain::simplify::simplify;
+use solver::grain::simplify::{DEFAULT_MAX_FACES, simplify};
 use solver::grain::{MeshLibrary, TriMesh, UnitMesh, folder_meshes, rhine_meshes};
 
 pub const RHINE: &str = "builtin:rhine";
@@ -44,7 +44,7 @@ pub fn reload(library: &mut MeshLibrary) -> anyhow::Result<()> {
 fn prepare(source: &str, faces: usize) -> anyhow::Result<Vec<UnitMesh>> {
     let named: Vec<(String, TriMesh)> = match source {
         RHINE => rhine_meshes(),
-        PEBBLES => pebble_library(PEBBLE_COUNT, 1, faces.min(300))
+        PEBBLES => pebble_library(PEBBLE_COUNT, 1, faces.min(DEFAULT_MAX_FACES))
             .map_err(|e| anyhow!("{PEBBLES}: a pebble mesh {e}"))?
             .into_iter()
             .enumerate()

@@ -1,10 +1,28 @@
-//! Printing results: one JSON object with `--json`, an aligned table otherwise.
+//! Printing results: one JSON object with `--json`, an aligned table otherwise. Every write to
+//! standard output returns its error instead of panicking, so that a closed pipe
+//! (`sedpack … | head`) ends the command, and `main` ends it quietly.
 
 use serde::Serialize;
 
+/// `println!` that returns the write's error rather than panicking on it.
+#[macro_export]
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout().lock(), $($arg)*)
+    }};
+}
+
 pub fn print_json(value: &impl Serialize) -> anyhow::Result<()> {
-    println!("{}", serde_json::to_string_pretty(value)?);
+    outln!("{}", serde_json::to_string_pretty(value)?)?;
     Ok(())
+}
+
+/// Whether an error is standard output closed under us (`EPIPE`): the reader has all it wanted.
+pub fn is_closed_pipe(error: &anyhow::Error) -> bool {
+    error
+        .chain()
+        .any(|cause| cause.downcast_ref::<std::io::Error>().is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe))
 }
 
 /// A two-column table of labelled values, printed with aligned columns.
@@ -19,11 +37,12 @@ impl Table {
         self
     }
 
-    pub fn print(&self) {
+    pub fn print(&self) -> std::io::Result<()> {
         let width = self.rows.iter().map(|(l, _)| l.chars().count()).max().unwrap_or(0);
         for (label, value) in &self.rows {
-            println!("{label:<width$}  {value}");
+            outln!("{label:<width$}  {value}")?;
         }
+        Ok(())
     }
 }
 

@@ -1,22 +1,26 @@
 //! The campaign runner: workers claim pending jobs from the store and run each packing in a
 //! blocking task with its own rayon pool, sending heartbeats and checkpoints while it runs. A
-//! Ctrl-C returns running jobs to pending; jobs of a killed runner are found by their dead
-//! process or their stale heartbeat and run again, from their last checkpoint.
+//! Ctrl-C returns running jobs to pending, and so does a worker that fails (a store error): it
+//! stops the others, which return their jobs too. Jobs of a killed runner are found by their
+//! dead process or their stale heartbeat and run again, from their last checkpoint when this
+//! version can use it (and saying why when it cannot).
 
 use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use anyhow::Context;
+use anyhow::anyhow;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use solver::packing::{Packing, PackingResult, Phase};
-use store::{GrainStatistic, JobResult, ProfilePoint, Store};
+use store::{Checkpoint, ClaimedJob, Store};
 use tokio::sync::mpsc;
 use tracing::{info, warn};
 
 use crate::meshes;
+use crate::records::result_rows;
 use crate::spec::JobSpec;
+use crate::stored;
 
 /// A running job proves it is alive this often.
 const HEARTBEAT: Duration = Duration::from_secs(10);
@@ -24,6 +28,10 @@ const HEARTBEAT: Duration = Duration::from_secs(10);
 const STALE_AFTER: Duration = Duration::from_secs(60);
 /// Time steps between progress reports and cancellation checks (0.05 s simulated at the default Δt).
 const STEPS_PER_REPORT: u64 = 10_000;
+/// A checkpoint is this number followed by the packing; a checkpoint with another number was
+/// written by another version of sedpack and is not used. Raise it whenever `Packing`'s
+/// serialised form changes.
+const CHECKPOINT_FORMAT: u32 = 2;
 
 #[derive(Debug, Clone)]
 pub struct RunOptions {
@@ -43,6 +51,8 @@ pub struct Summary {
 enum Message {
     Progress(solver::packing::Progress),
     Checkpoint(Vec<u8>, f64),
+    /// Something the user should know, such as a checkpoint that cannot be used.
+    Warning(String),
 }
 
 enum Outcome {
@@ -138,14 +148,27 @@ pub async fn run(store: &Store, campaign: &str, options: &RunOptions, interactiv
         };
         handles.push(tokio::spawn(context.run()));
     }
+    // A worker that fails has already told the others to stop; wait for all of them, so that
+    // every job is back to pending before the error is reported.
     let mut summary = Summary::default();
+    let mut failure = None;
     for handle in handles {
-        let s = handle.await.context("a worker panicked")??;
-        summary.completed += s.completed;
-        summary.failed += s.failed;
+        match handle.await.map_err(|panic| anyhow!("a worker panicked: {panic}")).and_then(|r| r) {
+            Ok(s) => {
+                summary.completed += s.completed;
+                summary.failed += s.failed;
+            }
+            Err(e) => {
+                cancel.store(true, Ordering::SeqCst);
+                failure.get_or_insert(e);
+            }
+        }
+    }
+    total.finish_and_clear();
+    if let Some(e) = failure {
+        return Err(e);
     }
     summary.interrupted = cancel.load(Ordering::SeqCst);
-    total.finish_and_clear();
     Ok(summary)
 }
 
@@ -161,52 +184,73 @@ struct Worker {
 }
 
 impl Worker {
+    /// Works until no job is left or the run is stopped; on an error, tells the other workers
+    /// to stop before returning it.
     async fn run(self) -> anyhow::Result<Summary> {
+        let result = self.work().await;
+        if result.is_err() {
+            self.cancel.store(true, Ordering::SeqCst);
+        }
+        self.bar.finish_and_clear();
+        result
+    }
+
+    async fn work(&self) -> anyhow::Result<Summary> {
         let mut summary = Summary::default();
         let pool = Arc::new(rayon::ThreadPoolBuilder::new().num_threads(self.threads).build()?);
-        loop {
-            if self.cancel.load(Ordering::SeqCst) {
-                break;
-            }
+        while !self.cancel.load(Ordering::SeqCst) {
             let claimed = match self.store.claim(&self.campaign, &self.id).await? {
                 Some(job) => job,
                 // Nothing pending: jobs of runners that died meanwhile may be waiting.
                 None if recover(&self.store, &self.campaign).await? > 0 => continue,
                 None => break,
             };
-            let label: Vec<String> = claimed.parameters.iter().map(|(k, v)| format!("{k}={v}")).collect();
-            let label = format!("{} ({})", claimed.id.get(..8).unwrap_or(&claimed.id), label.join(", "));
-            info!(job = %claimed.id, worker = %self.id, attempt = claimed.attempts, "started");
-            let outcome = match read_spec(&claimed.spec) {
-                Ok(spec) => self.execute(&claimed.id, spec, &label, pool.clone()).await?,
-                Err(e) => Outcome::Failed(format!("{e:#}")),
-            };
-            match outcome {
-                Outcome::Done(result) => {
-                    let (row, statistics) = store_rows(&result);
-                    self.store.complete(&claimed.id, &self.id, &row, &statistics).await?;
-                    info!(job = %claimed.id, porosity = result.porosity.bulk, "done");
-                    summary.completed += 1;
-                    self.total.inc(1);
+            if let Err(e) = self.handle(&claimed, pool.clone(), &mut summary).await {
+                // The job goes back to pending now rather than after a stale-heartbeat recovery.
+                if let Ok(true) = self.store.release(&claimed.id, &self.id).await {
+                    info!(job = %claimed.id, "returned to pending after the worker's error");
                 }
-                Outcome::Cancelled => {
-                    if self.store.release(&claimed.id, &self.id).await? {
-                        info!(job = %claimed.id, "returned to pending");
-                    }
-                    if self.cancel.load(Ordering::SeqCst) {
-                        break;
-                    }
-                }
-                Outcome::Failed(error) => {
-                    warn!(job = %claimed.id, %error, "failed");
-                    self.store.fail(&claimed.id, &self.id, &error).await?;
-                    summary.failed += 1;
-                    self.total.inc(1);
-                }
+                return Err(e.context(format!("worker {} on job {}", self.id, claimed.id)));
             }
         }
-        self.bar.finish_and_clear();
         Ok(summary)
+    }
+
+    /// Runs a claimed job and records how it ended.
+    async fn handle(
+        &self,
+        claimed: &ClaimedJob,
+        pool: Arc<rayon::ThreadPool>,
+        summary: &mut Summary,
+    ) -> anyhow::Result<()> {
+        let label: Vec<String> = claimed.parameters.iter().map(|(k, v)| format!("{k}={v}")).collect();
+        let label = format!("{} ({})", claimed.id.get(..8).unwrap_or(&claimed.id), label.join(", "));
+        info!(job = %claimed.id, worker = %self.id, attempt = claimed.attempts, "started");
+        let outcome = match read_spec(claimed.format, &claimed.spec) {
+            Ok(spec) => self.execute(&claimed.id, spec, &label, pool).await?,
+            Err(e) => Outcome::Failed(format!("{e:#}")),
+        };
+        match outcome {
+            Outcome::Done(result) => {
+                let (row, statistics) = result_rows(&result);
+                self.store.complete(&claimed.id, &self.id, &row, &statistics).await?;
+                info!(job = %claimed.id, porosity = result.porosity.bulk, "done");
+                summary.completed += 1;
+                self.total.inc(1);
+            }
+            Outcome::Cancelled => {
+                if self.store.release(&claimed.id, &self.id).await? {
+                    info!(job = %claimed.id, "returned to pending");
+                }
+            }
+            Outcome::Failed(error) => {
+                warn!(job = %claimed.id, %error, "failed");
+                self.store.fail(&claimed.id, &self.id, &error).await?;
+                summary.failed += 1;
+                self.total.inc(1);
+            }
+        }
+        Ok(())
     }
 
     /// Runs one packing in a blocking task, relaying its progress, heartbeats and checkpoints.
@@ -218,26 +262,27 @@ impl Worker {
         pool: Arc<rayon::ThreadPool>,
     ) -> anyhow::Result<Outcome> {
         let checkpoint = self.store.load_checkpoint(job).await?;
-        if let Some(c) = &checkpoint {
-            info!(job, simulated_time = c.simulated_time, "resuming from a checkpoint");
-        }
         let (sender, mut receiver) = mpsc::channel(4);
         let stop = [self.cancel.clone(), Arc::new(AtomicBool::new(false))];
         let lost = stop[1].clone();
         let interval = self.checkpoint_interval;
+        let id = job.to_string();
         let mut task = tokio::task::spawn_blocking(move || {
-            pool.install(|| simulate(spec, checkpoint.map(|c| c.data), &sender, &stop, interval))
+            pool.install(|| simulate(&id, spec, checkpoint, &sender, &stop, interval))
         });
         let mut heartbeat = tokio::time::interval(HEARTBEAT);
         loop {
             tokio::select! {
-                outcome = &mut task => {
-                    return Ok(outcome.unwrap_or_else(|panic| Outcome::Failed(format!("the solver panicked: {panic}"))));
-                }
+                // Messages first, so that none sent before the packing ended is lost.
+                biased;
                 Some(message) = receiver.recv() => match message {
                     Message::Progress(p) => self.bar.set_message(format!(
                         "{label}: {} t = {:.3} s, {} grains, {} contacts", p.phase.name(), p.time, p.grains, p.contacts
                     )),
+                    Message::Warning(text) => {
+                        warn!(job, "{text}");
+                        self.bar.println(format!("sedpack: warning: job {job}: {text}"));
+                    }
                     Message::Checkpoint(data, time) => {
                         if let Err(e) = self.store.save_checkpoint(job, &self.id, &data, time).await {
                             warn!(job, error = %e, "checkpoint not saved; stopping the job");
@@ -247,6 +292,9 @@ impl Worker {
                         }
                     }
                 },
+                outcome = &mut task => {
+                    return Ok(outcome.unwrap_or_else(|panic| Outcome::Failed(format!("the solver panicked: {panic}"))));
+                }
                 _ = heartbeat.tick() => {
                     // A job taken away (e.g. requeued as stale) must not be finished twice.
                     if let Err(e) = self.store.heartbeat(job, &self.id).await {
@@ -262,22 +310,21 @@ impl Worker {
 /// The packing loop of a worker: from a checkpoint or from scratch, reporting progress and
 /// writing checkpoints, until converged, failed or cancelled.
 fn simulate(
+    job: &str,
     spec: JobSpec,
-    checkpoint: Option<Vec<u8>>,
+    checkpoint: Option<Checkpoint>,
     sender: &mpsc::Sender<Message>,
     stop: &[Arc<AtomicBool>; 2],
     interval: Duration,
 ) -> Outcome {
-    let restored = checkpoint.and_then(|data| match postcard::from_bytes::<Packing>(&data) {
-        Ok(mut packing) if packing.spec() == &spec.packing => {
-            // A checkpoint keeps only the digest of the meshes; the job brought them back.
-            match &spec.packing.grains.meshes {
-                Some(library) => packing.attach_meshes(library).ok().map(|_| packing),
-                None => Some(packing),
-            }
+    let restored = checkpoint.and_then(|c| match restore(&c.data, &spec) {
+        Ok(packing) => {
+            info!(job, simulated_time = c.simulated_time, "resuming from a checkpoint");
+            Some(packing)
         }
-        _ => {
-            warn!("ignoring a checkpoint that does not match the job");
+        Err(why) => {
+            let _ =
+                sender.blocking_send(Message::Warning(format!("its checkpoint cannot be used: {why}; starting over")));
             None
         }
     });
@@ -301,7 +348,7 @@ fn simulate(
             return Outcome::Cancelled;
         }
         if last_checkpoint.elapsed() >= interval {
-            match postcard::to_allocvec(&packing) {
+            match postcard::to_allocvec(&(CHECKPOINT_FORMAT, &packing)) {
                 Ok(data) => {
                     if sender.blocking_send(Message::Checkpoint(data, packing.simulation.time)).is_err() {
                         return Outcome::Cancelled;
@@ -318,33 +365,60 @@ fn simulate(
     }
 }
 
+/// The packing a checkpoint holds, if this version wrote it for this job; otherwise why not.
+fn restore(data: &[u8], spec: &JobSpec) -> Result<Packing, String> {
+    let unreadable = |e: postcard::Error| format!("it cannot be read ({e})");
+    let (format, rest) = postcard::take_from_bytes::<u32>(data).map_err(unreadable)?;
+    if format != CHECKPOINT_FORMAT {
+        return Err(format!(
+            "another version of sedpack wrote it (checkpoint format {format}; this version reads {CHECKPOINT_FORMAT})"
+        ));
+    }
+    let mut packing: Packing = postcard::from_bytes(rest).map_err(unreadable)?;
+    if packing.spec() != &spec.packing {
+        return Err("it belongs to another spec than the job's".into());
+    }
+    // A checkpoint keeps only the digest of the meshes; the job brought them back.
+    if let Some(library) = &spec.packing.grains.meshes {
+        packing.attach_meshes(library).map_err(|e| format!("its meshes cannot be attached again: {e}"))?;
+    }
+    Ok(packing)
+}
+
 /// A stored job's spec, with its meshes loaded again and checked against their digest.
-fn read_spec(stored: &serde_json::Value) -> anyhow::Result<JobSpec> {
-    let mut spec: JobSpec =
-        serde_json::from_value(stored.clone()).context("the stored spec cannot be read by this version of sedpack")?;
+fn read_spec(format: u32, json: &serde_json::Value) -> anyhow::Result<JobSpec> {
+    let mut spec = stored::decode(format, json)?;
     if let Some(library) = &mut spec.packing.grains.meshes {
         meshes::reload(library)?;
     }
     Ok(spec)
 }
 
-fn store_rows(result: &PackingResult) -> (JobResult, Vec<GrainStatistic>) {
-    let p = &result.porosity;
-    let row = JobResult {
-        porosity: p.bulk,
-        z_minus: p.z_minus,
-        z_plus: p.z_plus,
-        profile: p.profile.iter().map(|q| ProfilePoint { z: q.z, n: q.n }).collect(),
-        particles: result.particles as u64,
-        simulated_time: result.simulated_time,
-        steps: result.steps,
-        wall_time: result.wall_time.as_secs_f64(),
-        solver_version: solver::VERSION.to_string(),
-    };
-    let statistics = result
-        .statistics
-        .iter()
-        .map(|s| GrainStatistic { name: s.name.to_string(), mean: s.mean, std: s.std })
-        .collect();
-    (row, statistics)
+#[cfg(test)]
+mod tests {
+    use solver::packing::{DomainKind, PackingSpec};
+
+    use super::*;
+
+    fn job(seed: u64) -> JobSpec {
+        JobSpec {
+            name: "j".into(),
+            packing: PackingSpec { seed, ..PackingSpec::paper(DomainKind::Periodic) },
+            experiment: None,
+        }
+    }
+
+    #[test]
+    fn a_checkpoint_is_used_only_by_its_own_job_and_format_and_says_why_not() {
+        let packing = Packing::new(job(1).packing).unwrap();
+        let data = postcard::to_allocvec(&(CHECKPOINT_FORMAT, &packing)).unwrap();
+        assert_eq!(restore(&data, &job(1)).unwrap().spec(), packing.spec());
+        let other = restore(&data, &job(2)).unwrap_err();
+        assert!(other.contains("another spec"), "{other}");
+        // sedpack 0.1.0 wrote the packing alone, which starts with the domain's variant (0).
+        let old = postcard::to_allocvec(&packing).unwrap();
+        let why = restore(&old, &job(1)).unwrap_err();
+        assert!(why.contains("another version of sedpack wrote it (checkpoint format 0"), "{why}");
+        assert!(restore(&[], &job(1)).unwrap_err().contains("cannot be read"));
+    }
 }

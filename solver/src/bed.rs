@@ -21,8 +21,8 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::SolverError;
 use crate::dem::shape::{ConvexPolyhedron, Polyhedron};
-use crate::dem::{Calibration, Domain, NewBody, Settings, Shape, Simulation, uniform_rotation};
-use crate::grain::{FormDistribution, SieveCurve, UnitMesh, bonded_grain, rhine_meshes, simplify};
+use crate::dem::{Calibration, Domain, Material, NewBody, Settings, Shape, Simulation, uniform_rotation};
+use crate::grain::{RHINE_FORMS, SieveCurve, UnitMesh, bonded_grain, rhine_meshes, simplify};
 use crate::packing::ShapeKind;
 
 /// Diameter of the LAMMPS bed's spheres (m).
@@ -31,9 +31,6 @@ pub const SPHERE_DIAMETER: f64 = 6.7e-3;
 const SPHERE_ROW: usize = 7;
 const SPHERE_SITE: f64 = 0.05 / 7.0;
 const SPHERE_LAYER: f64 = 0.010;
-/// The Rhine form distribution of Table 2.
-pub const RHINE_FORMS: FormDistribution =
-    FormDistribution { mu_fl: 0.647, sigma_fl: 0.175, mu_el: 0.682, sigma_el: 0.139 };
 /// The sieve class of the other beds (m).
 const CLASS: [f64; 2] = [5.6e-3, 8e-3];
 
@@ -64,20 +61,9 @@ impl BedSpec {
     }
 }
 
-/// The paper's material (§4.2) with gravity along −z and the given skin.
+/// The paper's material and time step (§4.2) with the given skin.
 pub fn settings(skin: f64) -> Settings {
-    Settings {
-        density: 2650.0,
-        fluid_density: 1000.0,
-        gravity: Vector3::new(0.0, 0.0, -9.81),
-        restitution: 0.1,
-        collision_time: 2e-4,
-        poisson_ratio: 0.22,
-        friction: 0.5,
-        time_step: 5e-6,
-        skin,
-        calibration: Calibration::Discrete { time_step: 5e-6 },
-    }
+    Settings { material: Material::default(), time_step: 5e-6, skin, calibration: Calibration::Discrete }
 }
 
 /// Where a bed's preparation stands, for progress displays.
@@ -194,7 +180,7 @@ fn sphere_lattice(grains: usize, rng: &mut ChaCha8Rng) -> Result<Simulation, Sol
 /// Grains of the 5.6–8 mm class on a lattice as wide as their largest reach, falling at 1 m/s.
 fn grain_lattice(spec: &BedSpec, rng: &mut ChaCha8Rng) -> Result<Simulation, SolverError> {
     let sizes = SieveCurve::new(CLASS.to_vec(), vec![1.0]).expect("one class").sampler();
-    let forms = RHINE_FORMS.sampler();
+    let forms = RHINE_FORMS.sampler().expect("Table 2's distribution lies in the admissible ranges");
     let bases: Vec<Arc<ConvexPolyhedron>> = match spec.shape {
         ShapeKind::Mesh => rhine_meshes()
             .iter()

@@ -1,6 +1,6 @@
-//! The ellipsoid narrow phase against references built independently of it (issue 3, item 3:
-//! depth and normal within 1e-6, relative to the smallest semi-axis, of a high-precision
-//! reference; the same point, depth and opposite normal for both bodies of a pair).
+//! The ellipsoid narrow phase against references built independently of it: depth and normal
+//! within 1e-6, relative to the smallest semi-axis, of a high-precision reference; the same
+//! point, depth and opposite normal for both bodies of a pair.
 //!
 //! The references evaluate the support function in the body frame, |diag(a, b, c) Rᵀ n|, never
 //! through the library's Q, and find minima by a dense latitude–longitude grid, a compass search
@@ -17,7 +17,7 @@ use solver::dem::uniform_rotation;
 
 type V3 = Vector3<f64>;
 
-/// The issue's acceptance tolerance for depth (relative to the smallest semi-axis) and normal.
+/// Accepted error of depth (relative to the smallest semi-axis) and normal.
 const ACCEPTANCE: f64 = 1e-6;
 
 #[derive(Debug, Clone, Copy)]
@@ -280,7 +280,7 @@ fn check_against_reference(a: &Body, b: &Body, tally: &mut Tally) {
         "normal {} vs reference {best_normal} (error {normal_error:e}), minima {minima:?}: {a:?} {b:?}",
         c.normal
     );
-    // The point from the reference normal, to which the solver's is held at the issue's tolerance.
+    // The point from the reference normal, to which the solver's is held at the accepted tolerance.
     let point_error = minima
         .iter()
         .filter(|m| m.0 <= best + 1e-9 * s)
@@ -505,7 +505,7 @@ fn aligned_twins_offset_along_their_long_axis_have_the_ellipse_distance() {
             (to_point.norm(), vec![V3::new(n.x, 0.0, n.y), V3::new(n.x, 0.0, -n.y)])
         };
         // Near x0 = P − S²/P the two minima merge into a quartic one whose normal f64 resolves
-        // only to ~ε^(1/4), so the issue's tolerance is the one to hold here.
+        // only to ~ε^(1/4), so the accepted tolerance is the one to hold here.
         let s_min = axes.min();
         assert!((c.depth - depth).abs() < ACCEPTANCE * s_min, "depth {} vs {depth}", c.depth);
         let body_normal = r.transpose() * c.normal;

@@ -1,4 +1,4 @@
-//! The convex-polyhedron narrow phase (issue 4, item 1; §3.1) against hand-built cases with known
+//! The convex-polyhedron narrow phase (§3.1) against hand-built cases with known
 //! answers and against references built independently of it:
 //!
 //! * depth and normal of polyhedron pairs: the separating-axis theorem evaluated by brute force

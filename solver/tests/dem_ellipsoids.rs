@@ -5,8 +5,8 @@
 use nalgebra::{UnitQuaternion, Vector3};
 mod common;
 
-use common::{momenta, settings};
-use solver::dem::{Calibration, Domain, NewBody, Shape, Simulation};
+use common::{collide, momenta, settings, slide_x};
+use solver::dem::{Domain, NewBody, Shape, Simulation};
 
 const G: f64 = 9.81;
 
@@ -23,21 +23,6 @@ fn ellipsoid(
         velocity,
         angular_velocity: Vector3::zeros(),
     }
-}
-
-/// Runs until the bodies separate after their first contact; returns the contact steps.
-fn collide(sim: &mut Simulation) -> u64 {
-    let (mut steps, mut touched) = (0, false);
-    for _ in 0..100_000 {
-        sim.step().unwrap();
-        if sim.contacts > 0 {
-            touched = true;
-            steps += 1;
-        } else if touched {
-            return steps;
-        }
-    }
-    panic!("no collision");
 }
 
 #[test]
@@ -57,7 +42,7 @@ fn head_on_ellipsoids_rebound_with_the_restitution_coefficient_after_the_collisi
     let steps = collide(&mut sim);
     let v = &sim.bodies.velocity;
     let e = v[1].x - v[0].x;
-    // The tolerances: 2 % on e_n, 5 % on T_c.
+    // Accepted: 2 % off e_n, 5 % off T_c.
     assert!((e - 0.1).abs() < 0.002, "restitution {e}");
     assert!((steps as f64 * 5e-6 - 2e-4).abs() < 0.05 * 2e-4, "contact lasted {steps} steps");
     assert!(sim.bodies.angular_velocity.iter().all(|w| w.norm() < 1e-9), "a central collision spins nothing");
@@ -94,7 +79,6 @@ fn an_oblique_collision_of_tilted_ellipsoids_conserves_momentum() {
 fn tumble(time_step: f64) -> (f64, f64, f64) {
     let mut s = settings(0.1, 0.5, Vector3::zeros());
     s.time_step = time_step;
-    s.calibration = Calibration::Discrete { time_step };
     let mut sim = Simulation::new(Domain::Periodic { width: 0.1 }, s).unwrap();
     let mut body =
         ellipsoid([4e-3, 2e-3, 1e-3], Vector3::new(0.05, 0.05, 0.05), UnitQuaternion::identity(), Vector3::zeros());
@@ -144,14 +128,7 @@ fn slide(theta_degrees: f64, friction: f64, time: f64, settle: bool) -> (f64, f6
         }
         sim.damping = None;
     }
-    let (x0, v0) = (sim.bodies.position[0].x, sim.bodies.velocity[0].x);
-    let n = (time / 5e-6) as usize;
-    for _ in 0..n {
-        sim.step().unwrap();
-    }
-    let t = n as f64 * 5e-6;
-    let dx = sim.bodies.position[0].x - x0;
-    (dx, 2.0 * (dx - v0 * t) / (t * t))
+    slide_x(&mut sim, time)
 }
 
 #[test]

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{box_mesh, momenta, settings};
+use common::{box_mesh, momenta, settings, slide_x};
 use nalgebra::{UnitQuaternion, Vector3};
 use solver::dem::shape::Polyhedron;
 use solver::dem::{Domain, NewBody, Shape, Simulation};
@@ -38,14 +38,9 @@ fn on_slope(
     for _ in 0..20_000 {
         sim.step().unwrap();
     }
-    let (x0, v0, q0) = (sim.bodies.position[0].x, sim.bodies.velocity[0].x, sim.bodies.orientation[0]);
-    let n = (time / 5e-6) as usize;
-    for _ in 0..n {
-        sim.step().unwrap();
-    }
-    let t = n as f64 * 5e-6;
-    let dx = sim.bodies.position[0].x - x0;
-    (dx, 2.0 * (dx - v0 * t) / (t * t), sim.bodies.orientation[0].angle_to(&q0))
+    let q0 = sim.bodies.orientation[0];
+    let (dx, a) = slide_x(&mut sim, time);
+    (dx, a, sim.bodies.orientation[0].angle_to(&q0))
 }
 
 #[test]

@@ -111,7 +111,7 @@ fn truncated(mu: f64, sigma: f64) -> (f64, f64) {
 fn sampled_forms_follow_the_truncated_normals() {
     for (mu_fl, s_fl, mu_el, s_el) in [(0.647, 0.175, 0.682, 0.139), (0.4, 0.2, 0.8, 0.2), (0.9, 0.3, 0.15, 0.1)] {
         let dist = FormDistribution::new(mu_fl, s_fl, mu_el, s_el).unwrap();
-        let sampler = dist.sampler();
+        let sampler = dist.sampler().unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(11);
         let count = 100_000;
         let pairs: Vec<(f64, f64)> = (0..count).map(|_| sampler.sample_flatness_elongation(&mut rng)).collect();

@@ -1,33 +1,20 @@
 //! Packings of real shapes run to convergence: convex polyhedra from the two Rhine scans, each
 //! keeping its own form (§5.1), and bonded-sphere grains (Sun & Xiao §2.4).
 
-use solver::dem::{Calibration, Domain, Shaking, Shape};
-use solver::grain::{FormDistribution, MeshLibrary, SieveCurve, UnitMesh, rhine_meshes};
-use solver::packing::{FormSpec, GrainSpec, Material, Packing, PackingSpec, Phase, Process, ShapeKind};
+mod common;
+
+use common::small_bed;
+use solver::dem::Shape;
+use solver::grain::{MeshLibrary, RHINE_FORMS, UnitMesh, rhine_meshes};
+use solver::packing::{FormSpec, Packing, PackingSpec, Phase, ShapeKind};
 
 fn spec(shape: ShapeKind, form: FormSpec, meshes: Option<MeshLibrary>, mass: f64) -> PackingSpec {
-    PackingSpec {
-        domain: Domain::Periodic { width: 0.04 },
-        height: 0.15,
-        grains: GrainSpec { shape, size: SieveCurve::new(vec![5.6e-3, 8e-3], vec![1.0]).unwrap(), mass, form, meshes },
-        material: Material::default(),
-        time_step: 5e-6,
-        calibration: Calibration::Discrete { time_step: 5e-6 },
-        process: Process {
-            spacing: 0.012,
-            velocity: 1.0,
-            shaking: Shaking { amplitude: 3e-4, period: 0.025 },
-            shaking_duration: 0.05,
-            damping: 1e-3,
-            height_change: 1e-5,
-            interval: 0.01,
-            max_time: 5.0,
-        },
-        slice: 1e-3,
-        cutoff: 0.5,
-        trim: Some(4e-3),
-        seed: 3,
-    }
+    let mut spec = small_bed(shape, mass, 0.012, 0.05);
+    spec.grains.form = form;
+    spec.grains.meshes = meshes;
+    spec.trim = Some(4e-3);
+    spec.seed = 3;
+    spec
 }
 
 fn converge(packing: &mut Packing) -> f64 {
@@ -65,8 +52,8 @@ fn rhine_polyhedra_keep_their_own_forms_and_settle() {
 
 #[test]
 fn bonded_sphere_grains_settle() {
-    let rhine = FormDistribution { mu_fl: 0.647, sigma_fl: 0.175, mu_el: 0.682, sigma_el: 0.139 };
-    let mut packing = Packing::new(spec(ShapeKind::BondedSpheres, FormSpec::Distribution(rhine), None, 0.06)).unwrap();
+    let mut packing =
+        Packing::new(spec(ShapeKind::BondedSpheres, FormSpec::Distribution(RHINE_FORMS), None, 0.06)).unwrap();
     let n = converge(&mut packing);
     let b = &packing.simulation.bodies;
     assert!(b.len() > 80 && b.shape.iter().all(|s| matches!(s, Shape::Bonded(_))));

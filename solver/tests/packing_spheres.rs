@@ -1,40 +1,18 @@
 //! The packing protocol of §4.3 with equal spheres, against the literature on random packings,
 //! and the reproducibility of a packing across thread counts.
 
-use solver::dem::{Calibration, Domain, Shaking};
-use solver::grain::SieveCurve;
-use solver::packing::{FormSpec, GrainSpec, Material, Packing, PackingSpec, Phase, Process, ShapeKind};
+mod common;
+
+use common::small_bed;
+use solver::packing::{FormSpec, Packing, PackingSpec, Phase, ShapeKind};
 
 /// About 320 spheres of 5.6–8 mm in a 4 cm periodic square: a bed ~7 grains deep.
 fn spec(friction: f64, shaking_duration: f64, seed: u64) -> PackingSpec {
-    PackingSpec {
-        domain: Domain::Periodic { width: 0.04 },
-        height: 0.15,
-        grains: GrainSpec {
-            shape: ShapeKind::Sphere,
-            size: SieveCurve::new(vec![5.6e-3, 8e-3], vec![1.0]).unwrap(),
-            mass: 0.14,
-            form: FormSpec::Single { fl: 1.0, el: 1.0 },
-            meshes: None,
-        },
-        material: Material { friction, ..Material::default() },
-        time_step: 5e-6,
-        calibration: Calibration::Discrete { time_step: 5e-6 },
-        process: Process {
-            spacing: 0.009,
-            velocity: 1.0,
-            shaking: Shaking { amplitude: 3e-4, period: 0.025 },
-            shaking_duration,
-            damping: 1e-3,
-            height_change: 1e-5,
-            interval: 0.01,
-            max_time: 5.0,
-        },
-        slice: 1e-3,
-        cutoff: 0.5,
-        trim: None,
-        seed,
-    }
+    let mut spec = small_bed(ShapeKind::Sphere, 0.14, 0.009, shaking_duration);
+    spec.grains.form = FormSpec::Single { fl: 1.0, el: 1.0 };
+    spec.material.friction = friction;
+    spec.seed = seed;
+    spec
 }
 
 fn porosity(friction: f64) -> f64 {

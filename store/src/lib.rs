@@ -1,6 +1,7 @@
 //! sedpack's SQLite store: campaigns, the job queue, results, grain statistics and checkpoints.
 //!
-//! The store knows nothing of DEM or YAML: a job's spec and parameters are opaque JSON to it.
+//! The store knows nothing of DEM or YAML: a job's spec, its parameters and a result's porosity
+//! profile are opaque JSON to it.
 //! Several processes may share one database file: every state change is one statement or one
 //! write transaction, and a job changes hands only through [`Store::claim`]. Timestamps are UNIX
 //! seconds from the clock of the process that writes them.
@@ -16,12 +17,14 @@ use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use serde::Serialize;
 use serde::de::DeserializeOwned;
-use sqlx::sqlite::{SqliteConnectOptions, SqliteConnection, SqlitePool, SqlitePoolOptions, SqliteSynchronous};
+use sqlx::sqlite::{
+    SqliteConnectOptions, SqliteConnection, SqliteExecutor, SqlitePool, SqlitePoolOptions, SqliteSynchronous,
+};
 
 pub use error::StoreError;
 pub use types::{
     Campaign, CampaignStatus, Checkpoint, ClaimedJob, ExportRow, Failure, GrainStatistic, JobResult, JobState, NewJob,
-    ProfilePoint, RunningJob,
+    RunningJob,
 };
 
 /// How long a statement waits for another connection's lock before it fails.
@@ -103,9 +106,12 @@ impl Store {
             let inserted = sqlx::query(sql::INSERT_JOB)
                 .bind(&job.id)
                 .bind(campaign_id)
+                .bind(job.format)
                 .bind(self.encode_json(&job.spec, &format!("spec of job {}", job.id))?)
                 .bind(self.to_sql_int(job.seed, &format!("seed of job {}", job.id))?)
                 .bind(self.encode_json(&job.parameters, &format!("parameters of job {}", job.id))?)
+                .bind(job.experiment_porosity)
+                .bind(job.experiment_std)
                 .bind(now)
                 .execute(&mut *tx)
                 .await
@@ -134,17 +140,18 @@ impl Store {
         let mut conn = self.pool.acquire().await.map_err(self.db())?;
         let campaign_id = self.campaign_id(&mut conn, campaign).await?;
         // One UPDATE … RETURNING takes the write lock before it reads, so the pick is atomic.
-        let row: Option<(String, String, u64, String, u32)> = sqlx::query_as(sql::CLAIM_JOB)
+        let row: Option<(String, u32, String, u64, String, u32)> = sqlx::query_as(sql::CLAIM_JOB)
             .bind(campaign_id)
             .bind(worker_id)
             .bind(now())
             .fetch_optional(&mut *conn)
             .await
             .map_err(self.db())?;
-        let Some((id, spec, seed, parameters, attempts)) = row else {
+        let Some((id, format, spec, seed, parameters, attempts)) = row else {
             return Ok(None);
         };
         Ok(Some(ClaimedJob {
+            format,
             spec: self.decode_json(&spec, &format!("spec of job {id}"))?,
             parameters: self.decode_json(&parameters, &format!("parameters of job {id}"))?,
             id,
@@ -156,15 +163,7 @@ impl Store {
     /// Tells the store that `worker_id` is still working on the job.
     /// Fails with [`StoreError::NotOwner`] if the job was taken away, so the worker can stop.
     pub async fn heartbeat(&self, job_id: &str, worker_id: &str) -> Result<(), StoreError> {
-        let updated = sqlx::query(sql::HEARTBEAT)
-            .bind(job_id)
-            .bind(worker_id)
-            .bind(now())
-            .execute(&self.pool)
-            .await
-            .map_err(self.db())?
-            .rows_affected();
-        self.owned(updated, job_id, worker_id)
+        self.update_owned(&self.pool, sql::HEARTBEAT, job_id, worker_id, now(), None).await
     }
 
     /// Marks the job done with its result and grain statistics, all or nothing, and drops its
@@ -182,15 +181,7 @@ impl Store {
         let steps = self.to_sql_int(result.steps, &format!("steps of job {job_id}"))?;
         let now = now();
         let mut tx = self.pool.begin_with(sql::BEGIN_IMMEDIATE).await.map_err(self.db())?;
-        let finished = sqlx::query(sql::FINISH_JOB)
-            .bind(job_id)
-            .bind(worker_id)
-            .bind(now)
-            .execute(&mut *tx)
-            .await
-            .map_err(self.db())?
-            .rows_affected();
-        self.owned(finished, job_id, worker_id)?;
+        self.update_owned(&mut *tx, sql::FINISH_JOB, job_id, worker_id, now, None).await?;
         sqlx::query(sql::INSERT_RESULT)
             .bind(job_id)
             .bind(result.porosity)
@@ -224,16 +215,7 @@ impl Store {
     /// afresh rather than from the state that failed. Same ownership rule as [`Store::complete`].
     pub async fn fail(&self, job_id: &str, worker_id: &str, error: &str) -> Result<(), StoreError> {
         let mut tx = self.pool.begin_with(sql::BEGIN_IMMEDIATE).await.map_err(self.db())?;
-        let failed = sqlx::query(sql::FAIL_JOB)
-            .bind(job_id)
-            .bind(worker_id)
-            .bind(error)
-            .bind(now())
-            .execute(&mut *tx)
-            .await
-            .map_err(self.db())?
-            .rows_affected();
-        self.owned(failed, job_id, worker_id)?;
+        self.update_owned(&mut *tx, sql::FAIL_JOB, job_id, worker_id, now(), Some(error)).await?;
         sqlx::query(sql::DELETE_CHECKPOINT).bind(job_id).execute(&mut *tx).await.map_err(self.db())?;
         tx.commit().await.map_err(self.db())
     }
@@ -307,15 +289,7 @@ impl Store {
     ) -> Result<(), StoreError> {
         let now = now();
         let mut tx = self.pool.begin_with(sql::BEGIN_IMMEDIATE).await.map_err(self.db())?;
-        let updated = sqlx::query(sql::HEARTBEAT)
-            .bind(job_id)
-            .bind(worker_id)
-            .bind(now)
-            .execute(&mut *tx)
-            .await
-            .map_err(self.db())?
-            .rows_affected();
-        self.owned(updated, job_id, worker_id)?;
+        self.update_owned(&mut *tx, sql::HEARTBEAT, job_id, worker_id, now, None).await?;
         sqlx::query(sql::UPSERT_CHECKPOINT)
             .bind(job_id)
             .bind(data)
@@ -379,7 +353,7 @@ impl Store {
     /// Every job of the campaign in submission order, with its result and grain statistics,
     /// from one snapshot.
     pub async fn export(&self, campaign: &str) -> Result<Vec<ExportRow>, StoreError> {
-        type JobRow = (String, String, u64, u32, Option<String>, String, String);
+        type JobRow = (String, String, u64, u32, Option<String>, String, Option<f64>, Option<f64>);
         type ResultRow = (String, f64, f64, f64, String, u64, f64, u64, f64, String);
         let mut tx = self.pool.begin().await.map_err(self.db())?;
         let campaign_id = self.campaign_id(&mut tx, campaign).await?;
@@ -417,7 +391,7 @@ impl Store {
             statistics_by_job.entry(job_id).or_default().push(GrainStatistic { name, mean, std });
         }
         jobs.into_iter()
-            .map(|(job_id, state, seed, attempts, error, parameters, spec)| {
+            .map(|(job_id, state, seed, attempts, error, parameters, experiment_porosity, experiment_std)| {
                 Ok(ExportRow {
                     state: JobState::parse(&state)
                         .ok_or_else(|| self.invalid(format!("job {job_id} has the unknown state {state:?}")))?,
@@ -425,7 +399,8 @@ impl Store {
                     attempts,
                     error,
                     parameters: self.decode_json(&parameters, &format!("parameters of job {job_id}"))?,
-                    spec: self.decode_json(&spec, &format!("spec of job {job_id}"))?,
+                    experiment_porosity,
+                    experiment_std,
                     result: results_by_job.remove(&job_id),
                     grain_statistics: statistics_by_job.remove(&job_id).unwrap_or_default(),
                     job_id,
@@ -440,8 +415,23 @@ impl Store {
         id.ok_or_else(|| self.no_campaign(name))
     }
 
-    /// Turns "the ownership-checked UPDATE touched no row" into [`StoreError::NotOwner`].
-    fn owned(&self, updated: u64, job_id: &str, worker_id: &str) -> Result<(), StoreError> {
+    /// Runs an UPDATE of the job that applies only while it runs for `worker_id` (parameters: ?1
+    /// the job, ?2 the worker, ?3 the time, ?4 `text` if given); touching no row is
+    /// [`StoreError::NotOwner`].
+    async fn update_owned<'c>(
+        &self,
+        executor: impl SqliteExecutor<'c>,
+        statement: &'static str,
+        job_id: &str,
+        worker_id: &str,
+        now: f64,
+        text: Option<&str>,
+    ) -> Result<(), StoreError> {
+        let mut query = sqlx::query(statement).bind(job_id).bind(worker_id).bind(now);
+        if let Some(text) = text {
+            query = query.bind(text);
+        }
+        let updated = query.execute(executor).await.map_err(self.db())?.rows_affected();
         if updated == 1 {
             Ok(())
         } else {

@@ -25,7 +25,10 @@ fn migrator() -> Migrator {
         let sql = SqlStr::from_static(sql);
         Migration::new(version, description.into(), MigrationType::Simple, sql, false)
     };
-    Migrator::with_migrations(vec![migration(1, "schema", include_str!("../migrations/0001_schema.sql"))])
+    Migrator::with_migrations(vec![
+        migration(1, "schema", include_str!("../migrations/0001_schema.sql")),
+        migration(2, "job format and experiment", include_str!("../migrations/0002_job_format_and_experiment.sql")),
+    ])
 }
 
 /// Makes `path` an up-to-date sedpack database in WAL mode, creating it if missing.

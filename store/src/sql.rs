@@ -18,8 +18,9 @@ pub const CAMPAIGNS: &str = "SELECT name, spec, created_at, updated_at FROM camp
 
 // Jobs
 pub const INSERT_JOB: &str = "
-    INSERT INTO jobs (id, campaign_id, spec, seed, parameters, created_at)
-    VALUES (?1, ?2, ?3, ?4, ?5, ?6)
+    INSERT INTO jobs (id, campaign_id, format, spec, seed, parameters, experiment_porosity, experiment_std,
+                      created_at)
+    VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)
     ON CONFLICT (id) DO NOTHING";
 pub const JOB_CAMPAIGN: &str = "
     SELECT campaigns.name FROM jobs JOIN campaigns ON campaigns.id = jobs.campaign_id
@@ -30,7 +31,7 @@ pub const CLAIM_JOB: &str = "
         started_at = ?3, heartbeat_at = ?3, finished_at = NULL, wall_time = NULL, error = NULL
     WHERE state = 'pending' AND id = (
         SELECT id FROM jobs WHERE campaign_id = ?1 AND state = 'pending' ORDER BY rowid LIMIT 1)
-    RETURNING id, spec, seed, parameters, attempts";
+    RETURNING id, format, spec, seed, parameters, attempts";
 pub const HEARTBEAT: &str = "
     UPDATE jobs SET heartbeat_at = ?3
     WHERE id = ?1 AND worker_id = ?2 AND state = 'running'";
@@ -39,7 +40,7 @@ pub const FINISH_JOB: &str = "
     WHERE id = ?1 AND worker_id = ?2 AND state = 'running'";
 pub const FAIL_JOB: &str = "
     UPDATE jobs
-    SET state = 'failed', error = ?3, heartbeat_at = ?4, finished_at = ?4, wall_time = ?4 - started_at
+    SET state = 'failed', error = ?4, heartbeat_at = ?3, finished_at = ?3, wall_time = ?3 - started_at
     WHERE id = ?1 AND worker_id = ?2 AND state = 'running'";
 pub const RELEASE_JOB: &str = "
     UPDATE jobs SET state = 'pending', worker_id = NULL, heartbeat_at = NULL, started_at = NULL
@@ -87,7 +88,7 @@ pub const FAILURES: &str = "
     SELECT id, attempts, error FROM jobs
     WHERE campaign_id = ?1 AND state = 'failed' ORDER BY rowid";
 pub const EXPORT_JOBS: &str = "
-    SELECT id, state, seed, attempts, error, parameters, spec FROM jobs
+    SELECT id, state, seed, attempts, error, parameters, experiment_porosity, experiment_std FROM jobs
     WHERE campaign_id = ?1 ORDER BY rowid";
 pub const EXPORT_RESULTS: &str = "
     SELECT results.job_id, porosity, z_minus, z_plus, profile, particles, simulated_time, steps,

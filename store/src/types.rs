@@ -1,4 +1,5 @@
-//! The values that go in and out of the store. Specs and parameters are opaque JSON to it.
+//! The values that go in and out of the store. Specs, parameters and porosity profiles are
+//! opaque JSON to it.
 
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
@@ -44,28 +45,27 @@ pub struct Campaign {
 pub struct NewJob {
     /// Stable hash of the resolved spec; unique across all campaigns of the database.
     pub id: String,
+    /// The format `spec` is written in, for the caller that reads it back.
+    pub format: u32,
     pub spec: Value,
     pub seed: u64,
     /// Grid key (dotted) → the value this job takes.
     pub parameters: Map<String, Value>,
+    /// The measured porosity the job is compared with, if any, and its standard deviation, if given.
+    pub experiment_porosity: Option<f64>,
+    pub experiment_std: Option<f64>,
 }
 
 /// A job handed to a worker by [`crate::Store::claim`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ClaimedJob {
     pub id: String,
+    pub format: u32,
     pub spec: Value,
     pub seed: u64,
     pub parameters: Map<String, Value>,
     /// How many times the job has been claimed, this time included.
     pub attempts: u32,
-}
-
-/// Porosity of one slice; `z` is the slice centre in m.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct ProfilePoint {
-    pub z: f64,
-    pub n: f64,
 }
 
 /// What a finished packing reports.
@@ -74,7 +74,8 @@ pub struct JobResult {
     pub porosity: f64,
     pub z_minus: f64,
     pub z_plus: f64,
-    pub profile: Vec<ProfilePoint>,
+    /// The porosity profile as the caller wrote it.
+    pub profile: Value,
     pub particles: u64,
     /// s of simulated time.
     pub simulated_time: f64,
@@ -143,7 +144,8 @@ pub struct ExportRow {
     pub attempts: u32,
     pub error: Option<String>,
     pub parameters: Map<String, Value>,
-    pub spec: Value,
+    pub experiment_porosity: Option<f64>,
+    pub experiment_std: Option<f64>,
     pub result: Option<JobResult>,
     pub grain_statistics: Vec<GrainStatistic>,
 }

@@ -62,6 +62,10 @@ async fn a_new_file_gets_the_schema_the_mark_and_wal() {
         .execute(&mut conn)
         .await;
     assert!(bad_state.unwrap_err().to_string().contains("CHECK"));
+    let spread_alone = sqlx::query("INSERT INTO jobs (id, campaign_id, spec, seed, parameters, experiment_std, created_at) VALUES ('y', 1, '{}', 1, '{}', 0.01, 0)")
+        .execute(&mut conn)
+        .await;
+    assert!(spread_alone.unwrap_err().to_string().contains("CHECK"), "a spread without its measurement");
     conn.close().await.unwrap();
 }
 

@@ -15,17 +15,19 @@ const CHILD_WORKER: &str = "STORE_TEST_CHILD_WORKER";
 const CHILD_REPORT: &str = "STORE_TEST_CHILD_REPORT";
 const PROCESS_JOBS: usize = 60;
 
+/// The database, worker id and report file a parent test gave this child process; None when the
+/// ignored child test runs on its own.
+fn child_task() -> Option<(String, String, String)> {
+    Some((std::env::var(CHILD_DB).ok()?, std::env::var(CHILD_WORKER).ok()?, std::env::var(CHILD_REPORT).ok()?))
+}
+
 /// Run by `separate_processes_split_the_work` in child processes, as `sedpack run` would:
 /// open (maybe a new file), submit the campaign, then work. Reports how many jobs it added, then
 /// the ids it completed, one a line.
 #[tokio::test]
 #[ignore = "a child process of separate_processes_split_the_work"]
 async fn child_process_runner() {
-    let (Ok(path), Ok(worker_id), Ok(report)) =
-        (std::env::var(CHILD_DB), std::env::var(CHILD_WORKER), std::env::var(CHILD_REPORT))
-    else {
-        return;
-    };
+    let Some((path, worker_id, report)) = child_task() else { return };
     let store = Store::open(&path).await.unwrap();
     store.upsert_campaign(CAMPAIGN, CAMPAIGN_SPEC).await.unwrap();
     let added = store.add_jobs(CAMPAIGN, &jobs(0..PROCESS_JOBS)).await.unwrap();
@@ -73,11 +75,7 @@ fn separate_processes_split_the_work() {
 #[tokio::test]
 #[ignore = "a child process of a_killed_process_loses_no_finished_job"]
 async fn child_process_killed() {
-    let (Ok(path), Ok(worker_id), Ok(report)) =
-        (std::env::var(CHILD_DB), std::env::var(CHILD_WORKER), std::env::var(CHILD_REPORT))
-    else {
-        return;
-    };
+    let Some((path, worker_id, report)) = child_task() else { return };
     let store = Store::open(&path).await.unwrap();
     for _ in 0..3 {
         let job = store.claim(CAMPAIGN, &worker_id).await.unwrap().unwrap();

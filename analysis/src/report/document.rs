@@ -53,9 +53,14 @@ pub fn markdown(title: &str, blocks: &[Block]) -> String {
     out
 }
 
+/// Tables longer than this fold away in the HTML (`<details>`), so that the report reads
+/// through; the Markdown shows them whole.
+pub const FOLD_ROWS: usize = 15;
+
 const STYLE: &str = "body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222;line-height:1.45}\
-table{border-collapse:collapse;margin:1em 0;font-size:0.92em}\
-th,td{border:1px solid #bbb;padding:0.25em 0.6em;text-align:left;vertical-align:top}\
+div.table{max-width:100%;overflow-x:auto}table{border-collapse:collapse;margin:1em 0;font-size:0.92em}\
+th,td{border:1px solid #bbb;padding:0.25em 0.6em;text-align:left;vertical-align:top;overflow-wrap:anywhere}\
+summary{cursor:pointer;color:#335}\
 th{background:#eee}td.num{text-align:right;font-variant-numeric:tabular-nums}\
 code{background:#f3f3f3;padding:0 0.2em}figure{margin:1.5em 0}svg{max-width:100%;height:auto}\
 figcaption{font-style:italic;margin-top:0.3em}";
@@ -86,7 +91,11 @@ pub fn html(title: &str, blocks: &[Block]) -> String {
                 out.push_str("</ul>\n");
             }
             Block::Table { header, rows } => {
-                out.push_str("<table>\n<thead><tr>");
+                let fold = rows.len() > FOLD_ROWS;
+                if fold {
+                    let _ = writeln!(out, "<details>\n<summary>Show the {} rows of this table</summary>", rows.len());
+                }
+                out.push_str("<div class=\"table\">\n<table>\n<thead><tr>");
                 for h in header {
                     let _ = write!(out, "<th>{}</th>", inline(h));
                 }
@@ -99,7 +108,10 @@ pub fn html(title: &str, blocks: &[Block]) -> String {
                     }
                     out.push_str("</tr>\n");
                 }
-                out.push_str("</tbody>\n</table>\n");
+                out.push_str("</tbody>\n</table>\n</div>\n");
+                if fold {
+                    out.push_str("</details>\n");
+                }
             }
             Block::Figure { caption, svg, .. } => {
                 figure += 1;

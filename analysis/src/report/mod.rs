@@ -1,8 +1,9 @@
 //! The campaign report: report.md, a self-contained report.html (SVG inlined, no external
-//! resources), figures/*.svg for the Markdown, dataset.csv and models/*.json. The content
-//! follows the paper: campaign and packings (Fig. 11, Table 6), feature ranking and primary
-//! feature (Fig. 8), form-factor correlations (Fig. 3), pair and set models (Tables 9, 10),
-//! predicted against observed (Figs. 9, 12) and porosity profiles.
+//! resources), figures/*.svg for the Markdown, dataset.csv and models/*.json. It formats an
+//! analysis computed beforehand (`crate::campaign::analyse`) and computes nothing of its own. The
+//! content follows the paper: campaign and packings (Fig. 11, Table 6), feature ranking and
+//! primary feature (Fig. 8), form-factor correlations (Fig. 3), pair and set models (Tables 9,
+//! 10), predicted against observed (Figs. 9, 12) and porosity profiles.
 
 mod document;
 
@@ -12,13 +13,14 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 use thiserror::Error;
 
-use crate::correlation::correlation_matrix;
-use crate::dataset::{Dataset, DatasetError, FeatureKind};
-use crate::form_factors::{factors, symbol};
+use crate::campaign::{Analysis, PACKINGS_PER_FEATURE, Support};
+use crate::correlation::CorrelationMatrix;
+use crate::dataset::{Dataset, FeatureKind};
+use crate::form_factors::symbol;
 use crate::model::LinearModel;
 use crate::plots::{self, PlotError, ScatterPlot, ZinggPacking};
-use crate::record::{CampaignSummary, JobRecord};
-use crate::selection::{Candidate, Selection, SelectionOptions, select_models, set_label};
+use crate::record::{CampaignSummary, Experiment, JobRecord};
+use crate::selection::{Candidate, Selection, SelectionOptions, set_label};
 use document::Block;
 
 #[derive(Debug, Error)]
@@ -29,8 +31,6 @@ pub enum ReportError {
         #[source]
         source: std::io::Error,
     },
-    #[error(transparent)]
-    Dataset(#[from] DatasetError),
     #[error(transparent)]
     Plot(#[from] PlotError),
 }
@@ -45,32 +45,29 @@ pub struct ReportFiles {
     pub models: Vec<PathBuf>,
 }
 
-/// Analyses the finished jobs of a campaign and writes the report into `out_dir`.
+/// Writes the report of a campaign's finished jobs and their analysis into `out_dir`.
 pub fn write_report(
     summary: &CampaignSummary,
     records: &[JobRecord],
-    options: &SelectionOptions,
+    analysis: &Analysis,
     out_dir: &Path,
 ) -> Result<ReportFiles, ReportError> {
-    let dataset = match Dataset::from_records(records) {
-        Ok(d) => Some(d),
-        Err(DatasetError::NoRecords) => None,
-        Err(e) => return Err(e.into()),
-    };
-    let selection = dataset.as_ref().map(|d| select_models(d, &summary.name, options));
-
+    let dataset = analysis.dataset.as_ref();
+    let selection = analysis.selection.as_ref();
     let mut blocks = Vec::new();
-    campaign_section(&mut blocks, summary, records, dataset.as_ref());
+    campaign_section(&mut blocks, summary, records, dataset);
     packings_section(&mut blocks, records)?;
     experiment_section(&mut blocks, records);
-    match (&dataset, &selection) {
+    match (dataset, selection) {
         (Some(d), Some(Ok(s))) => {
             dataset_section(&mut blocks, d);
             ranking_section(&mut blocks, d, s)?;
-            correlation_section(&mut blocks, d)?;
+            if let Some(matrix) = &analysis.factor_correlation {
+                correlation_section(&mut blocks, d.kind(), matrix)?;
+            }
             filter_section(&mut blocks, s);
             pairs_section(&mut blocks, s);
-            sets_section(&mut blocks, d, s)?;
+            sets_section(&mut blocks, d, s, analysis)?;
         }
         (Some(d), Some(Err(e))) => {
             dataset_section(&mut blocks, d);
@@ -80,7 +77,7 @@ pub fn write_report(
         _ => blocks
             .push(Block::Paragraph("The campaign has no finished job yet, so there is nothing to analyse.".into())),
     }
-    method_section(&mut blocks, options, dataset.as_ref());
+    method_section(&mut blocks, &analysis.options, dataset);
 
     let io = |path: &Path| {
         let path = path.to_path_buf();
@@ -100,13 +97,13 @@ pub fn write_report(
         }
     }
     let mut models = Vec::new();
-    if let Some(Ok(s)) = &selection {
+    if let Some(Ok(s)) = selection {
         for fitted in s.sets.iter().filter_map(Candidate::fitted) {
             let json = serde_json::to_string_pretty(&fitted.model).expect("a model serialises");
             models.push(write(models_dir.join(model_file(&fitted.model)), &json)?);
         }
     }
-    let csv = dataset.as_ref().map_or_else(|| "job_id,porosity\n".to_string(), Dataset::to_csv);
+    let csv = dataset.map_or_else(|| "job_id,porosity\n".to_string(), Dataset::to_csv);
     let title = format!("Porosity report: {}", summary.name);
     Ok(ReportFiles {
         dataset: write(out_dir.join("dataset.csv"), &csv)?,
@@ -290,7 +287,7 @@ fn packings_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<()
 
 /// Table 6: runs of the same setup (parameters apart from the seed) against the measurement.
 fn experiment_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
-    let mut groups: Vec<(String, Vec<f64>, (f64, f64))> = Vec::new();
+    let mut groups: Vec<(String, Vec<f64>, Experiment)> = Vec::new();
     for r in records {
         let Some(experiment) = r.experiment else { continue };
         let setup: Vec<String> = r
@@ -315,7 +312,7 @@ fn experiment_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
     let mut differences = Vec::new();
     let rows = groups
         .iter()
-        .map(|(label, runs, (measured, measured_std))| {
+        .map(|(label, runs, experiment)| {
             let mean = runs.iter().sum::<f64>() / runs.len() as f64;
             // Population std of the runs, as Table 6 reports it (its U1 row: 0.382, 0.381, 0.386 → ± 0.002).
             let spread = if runs.len() > 1 {
@@ -324,12 +321,16 @@ fn experiment_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
             } else {
                 format!("{mean:.3}")
             };
+            let measured = experiment.porosity;
             differences.push((mean - measured).abs());
             vec![
                 label.clone(),
                 runs.iter().map(|n| format!("{n:.3}")).collect::<Vec<_>>().join(", "),
                 spread,
-                format!("{measured:.3} ± {measured_std:.3}"),
+                match experiment.std {
+                    Some(std) => format!("{measured:.3} ± {std:.3}"),
+                    None => format!("{measured:.3} (spread not given)"),
+                },
                 format!("{:.3}", mean - measured),
                 format!("{:.2}", 100.0 * (mean - measured) / measured),
             ]
@@ -422,22 +423,23 @@ fn ranking_section(blocks: &mut Vec<Block>, d: &Dataset, s: &Selection) -> Resul
     Ok(())
 }
 
-fn correlation_section(blocks: &mut Vec<Block>, d: &Dataset) -> Result<(), ReportError> {
-    let (names, what): (Vec<String>, &str) = match d.kind() {
-        FeatureKind::SingleForm => (factors().iter().map(|f| f.to_string()).collect(), "the 13 form factors"),
-        FeatureKind::Mixture => {
-            (factors().iter().map(|f| format!("mean_{f}")).collect(), "the packing means of the 13 form factors")
-        }
-    };
-    let matrix = correlation_matrix(d, &names);
+fn correlation_section(
+    blocks: &mut Vec<Block>,
+    kind: FeatureKind,
+    matrix: &CorrelationMatrix,
+) -> Result<(), ReportError> {
     if matrix.features.len() < 2 {
         return Ok(());
     }
+    let what = match kind {
+        FeatureKind::SingleForm => "the 13 form factors",
+        FeatureKind::Mixture => "the packing means of the 13 form factors",
+    };
     blocks.push(Block::Heading("Correlation of the form factors".into()));
     blocks.push(Block::Figure {
         file: "correlation".into(),
         caption: format!("Pearson correlation of {what} over the packings (like Fig. 3); grey cells are undefined (a constant factor)."),
-        svg: plots::heat_map("Correlation of the form factors", &matrix)?,
+        svg: plots::heat_map("Correlation of the form factors", matrix)?,
     });
     Ok(())
 }
@@ -517,10 +519,10 @@ fn pairs_section(blocks: &mut Vec<Block>, s: &Selection) {
     }
 }
 
-fn sets_section(blocks: &mut Vec<Block>, d: &Dataset, s: &Selection) -> Result<(), ReportError> {
+fn sets_section(blocks: &mut Vec<Block>, d: &Dataset, s: &Selection, analysis: &Analysis) -> Result<(), ReportError> {
     blocks.push(Block::Heading("Models (Table 10)".into()));
     blocks.push(Block::Paragraph(
-        "Multivariate feature sets built from the primary P, its counterpart of the other statistic P′ (μ ↔ σ), the second factor Q and its counterpart Q′, in the order of Table 10: P; P + P′; P + P′ + Q; P + P′ + Q + Q′; P + Q; P + P′ + Q′. The paper's own final set is added for comparison when the procedure did not reach it.".into(),
+        "Multivariate feature sets built from the primary P, its counterpart of the other statistic P′ (μ ↔ σ), the second factor Q and its counterpart Q′, in the order of Table 10: P; P + P′; P + P′ + Q; P + P′ + Q + Q′; P + Q; P + P′ + Q′. The paper's own final set is added for comparison when the procedure did not reach it. Each set's equation and model file, or why it could not be fitted, follow the table under its number.".into(),
     ));
     let mut columns: Vec<String> = Vec::new();
     for c in &s.sets {
@@ -530,26 +532,26 @@ fn sets_section(blocks: &mut Vec<Block>, d: &Dataset, s: &Selection) -> Result<(
             }
         }
     }
-    let mut header: Vec<String> = columns.iter().map(|f| symbol(f)).collect();
+    let mut header: Vec<String> = vec!["set".into()];
+    header.extend(columns.iter().map(|f| symbol(f)));
     header.extend(["MAE (×10⁻³)", "R²", "note"].map(String::from));
     let rows = s
         .sets
         .iter()
         .enumerate()
         .map(|(k, c)| {
-            let mut row: Vec<String> =
-                columns.iter().map(|f| if c.features.contains(f) { "✓".into() } else { "".into() }).collect();
+            let mut row = vec![format!("{}", k + 1)];
+            row.extend(columns.iter().map(|f| if c.features.contains(f) { "✓".into() } else { "".into() }));
             row.extend(metrics(c, false));
             let mut notes = Vec::new();
             if s.chosen == Some(k) {
-                notes.push("**chosen**".to_string());
+                notes.push("**chosen**");
             }
             if s.paper_set == Some(k) {
-                notes.push("paper's set".into());
+                notes.push("paper's set");
             }
-            match &c.result {
-                Ok(f) => notes.push(format!("`models/{}`", model_file(&f.model))),
-                Err(e) => notes.push(format!("not fitted: {e}")),
+            if c.result.is_err() {
+                notes.push("not fitted");
             }
             row.push(notes.join("; "));
             row
@@ -559,8 +561,14 @@ fn sets_section(blocks: &mut Vec<Block>, d: &Dataset, s: &Selection) -> Result<(
     blocks.push(Block::List(
         s.sets
             .iter()
-            .filter_map(Candidate::fitted)
-            .map(|f| format!("{}: {}", set_label(&f.model.features), equation(&f.model)))
+            .enumerate()
+            .map(|(k, c)| match &c.result {
+                Ok(f) => {
+                    let (label, model) = (set_label(&c.features), &f.model);
+                    format!("set {}, {label}: {}, `models/{}`", k + 1, equation(model), model_file(model))
+                }
+                Err(e) => format!("set {}, {}: not fitted: {e}", k + 1, set_label(&c.features)),
+            })
             .collect(),
     ));
 
@@ -581,6 +589,9 @@ fn sets_section(blocks: &mut Vec<Block>, d: &Dataset, s: &Selection) -> Result<(
         model_file(model),
         model_file(model)
     )));
+    if let Some(caution) = analysis.support().and_then(|support| caution(&support, cv.mae)) {
+        blocks.push(Block::Paragraph(caution));
+    }
     blocks.push(Block::Table {
         header: ["feature", "symbol", "coefficient", "training range"].map(String::from).to_vec(),
         rows: model
@@ -601,6 +612,28 @@ fn sets_section(blocks: &mut Vec<Block>, d: &Dataset, s: &Selection) -> Result<(
         svg: plots::predicted_vs_observed(&set_label(&model.features), d.porosity(), &chosen.fitted, &chosen.held_out)?,
     });
     Ok(())
+}
+
+/// A plain warning when the packings are few for the chosen model's features, saying how its
+/// cross-validated error compares with the other sets'.
+fn caution(support: &Support, mae: f64) -> Option<String> {
+    if !support.few {
+        return None;
+    }
+    let comparison = match (support.worst, support.better) {
+        (true, _) => "its cross-validated error is the largest of the fitted sets".to_string(),
+        (false, Some(better)) => format!(
+            "the set {} cross-validates better (MAE {:.2}×10⁻³ against {:.2}×10⁻³)",
+            set_label(&better.features),
+            better.mae().unwrap_or(f64::NAN) * 1e3,
+            mae * 1e3
+        ),
+        (false, None) => "it cross-validates best here, but on so few packings that may be chance".to_string(),
+    };
+    Some(format!(
+        "**Too few packings for this model:** {} packings for {} features, fewer than {PACKINGS_PER_FEATURE} per feature (the paper fitted four features to 52 packings). The largest set is kept by the paper's rule, not on the evidence: {comparison}. Run more packings before relying on it.",
+        support.packings, support.features
+    ))
 }
 
 fn method_section(blocks: &mut Vec<Block>, options: &SelectionOptions, dataset: Option<&Dataset>) {

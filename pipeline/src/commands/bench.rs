@@ -13,6 +13,7 @@ use solver::dem::{Shaking, Shape, Simulation};
 use solver::packing::ShapeKind;
 
 use crate::cli::{BenchArgs, BenchShape};
+use crate::outln;
 use crate::output::{number, print_json};
 
 /// Bumped whenever a cached bed of an earlier build can no longer be read back.
@@ -90,7 +91,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             for shaken in [false, true] {
                 let row = measure(&spec, &bed, t, steps, shaken)?;
                 if !args.json {
-                    print_row(&row, rows.is_empty());
+                    print_row(&row, rows.is_empty())?;
                 }
                 rows.push(row);
             }
@@ -192,9 +193,9 @@ fn measure(spec: &BedSpec, bed: &Simulation, threads: usize, steps: u64, shaken:
     })
 }
 
-fn print_row(row: &Row, header: bool) {
+fn print_row(row: &Row, header: bool) -> std::io::Result<()> {
     if header {
-        println!(
+        outln!(
             "{:<15} {:>6} {:>7} {:>8} {:>17} {:>10} {:>14} {:>12} {:>6}",
             "shape",
             "grains",
@@ -205,9 +206,9 @@ fn print_row(row: &Row, header: bool) {
             "contacts/grain",
             "bytes/grain",
             "load"
-        );
+        )?;
     }
-    println!(
+    outln!(
         "{:<15} {:>6} {:>7} {:>8} {:>17} {:>10} {:>14} {:>12} {:>6}",
         row.shape,
         row.grains,
@@ -218,7 +219,7 @@ fn print_row(row: &Row, header: bool) {
         format!("{:.2}", row.contacts_per_grain),
         format!("{:.0}", row.bytes_per_grain),
         row.load.map_or("?".into(), |l| format!("{l:.2}")),
-    );
+    )
 }
 
 fn deck_path(data: &Path) -> PathBuf {
@@ -248,7 +249,7 @@ fn write_lammps(bed: &Simulation, path: &Path) -> anyhow::Result<()> {
             "{} 1 {:.17e} {:.17e} {:.17e} {:.17e} {:.17e}\n",
             k + 1,
             2.0 * radius,
-            bed.settings.density,
+            bed.settings.material.density,
             wrap(p.x),
             wrap(p.y),
             p.z
@@ -276,13 +277,13 @@ fn write_lammps(bed: &Simulation, path: &Path) -> anyhow::Result<()> {
          timestep {dt:e}\nneighbor {skin:e} bin\nneigh_modify delay 0 every 1 check yes\n\
          thermo 5000\nrun ${{nsteps}}\n",
         d = 2.0 * b.bounding_radius[0],
-        rho = s.density,
-        rho_f = s.fluid_density,
-        g = -s.gravity.z,
-        e = s.restitution,
-        tc = s.collision_time,
-        nu = s.poisson_ratio,
-        mu = s.friction,
+        rho = s.material.density,
+        rho_f = s.material.fluid_density,
+        g = -s.material.gravity.z,
+        e = s.material.restitution,
+        tc = s.material.collision_time,
+        nu = s.material.poisson_ratio,
+        mu = s.material.friction,
         dt = s.time_step,
         skin = bed.neighbours().skin(),
     );

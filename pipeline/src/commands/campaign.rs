@@ -4,6 +4,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
+use analysis::csv;
 use anyhow::{Context, bail};
 use serde::Serialize;
 use serde_json::{Map, Value};
@@ -11,7 +12,9 @@ use store::{CampaignStatus, ExportRow, NewJob, Store};
 
 use crate::campaign::read_campaign;
 use crate::cli::{ExportArgs, ResumeArgs, RunArgs, StatusArgs};
+use crate::outln;
 use crate::output::{Table, print_json};
+use crate::records::new_job;
 use crate::runner::{self, RunOptions, Summary};
 
 pub(crate) fn runtime() -> anyhow::Result<tokio::runtime::Runtime> {
@@ -47,17 +50,23 @@ fn workers(requested: Option<usize>) -> anyhow::Result<usize> {
     }
 }
 
-fn report(name: &str, summary: Summary, status: &CampaignStatus) {
-    println!(
+fn report(name: &str, summary: Summary, status: &CampaignStatus) -> std::io::Result<()> {
+    outln!(
         "{name}: {} job(s) finished now, {} failed now; campaign: {} done, {} failed, {} pending, {} running",
-        summary.completed, summary.failed, status.done, status.failed, status.pending, status.running
-    );
+        summary.completed,
+        summary.failed,
+        status.done,
+        status.failed,
+        status.pending,
+        status.running
+    )?;
     for f in &status.failures {
-        println!("  failed {}: {}", f.job_id, f.error);
+        outln!("  failed {}: {}", f.job_id, f.error)?;
     }
     if summary.interrupted {
-        println!("interrupted: run `sedpack resume {name}` to finish the campaign");
+        outln!("interrupted: run `sedpack resume {name}` to finish the campaign")?;
     }
+    Ok(())
 }
 
 /// `--checkpoint-interval` as a duration: a positive, finite number of seconds.
@@ -78,30 +87,21 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     runtime()?.block_on(async {
         let store = Store::open(&args.db).await?;
         store.upsert_campaign(&campaign.name, &campaign.text).await?;
-        let jobs: Vec<NewJob> = campaign
-            .jobs
-            .iter()
-            .map(|j| NewJob {
-                id: j.id.clone(),
-                spec: serde_json::to_value(&j.spec).expect("a resolved spec serialises"),
-                seed: j.spec.packing.seed,
-                parameters: j.parameters.clone(),
-            })
-            .collect();
+        let jobs: Vec<NewJob> = campaign.jobs.iter().map(new_job).collect();
         let new = store.add_jobs(&campaign.name, &jobs).await?;
         if args.retry_failed {
             let retried = store.requeue_failed(&campaign.name).await?;
-            println!("{}: {retried} failed job(s) returned to pending", campaign.name);
+            outln!("{}: {retried} failed job(s) returned to pending", campaign.name)?;
         }
-        println!(
+        outln!(
             "{}: {} job(s), {new} new; database {}, log {}",
             campaign.name,
             jobs.len(),
             args.db.display(),
             log.display()
-        );
+        )?;
         let summary = runner::run(&store, &campaign.name, &options, !args.quiet).await?;
-        report(&campaign.name, summary, &store.status(&campaign.name).await?);
+        report(&campaign.name, summary, &store.status(&campaign.name).await?)?;
         Ok(())
     })
 }
@@ -116,7 +116,7 @@ pub fn resume(args: &ResumeArgs) -> anyhow::Result<()> {
         store.campaign(&args.name).await?;
         start_log(&args.db)?;
         let summary = runner::run(&store, &args.name, &options, !args.quiet).await?;
-        report(&args.name, summary, &store.status(&args.name).await?);
+        report(&args.name, summary, &store.status(&args.name).await?)?;
         Ok(())
     })
 }
@@ -146,13 +146,14 @@ pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
             records.push(status_record(store.status(name).await?));
         }
         if args.json {
-            return match (&args.name, records.pop()) {
-                (Some(_), Some(record)) => print_json(&record),
+            // One object for a named campaign, a list of every campaign otherwise.
+            return match (&args.name, records.as_slice()) {
+                (Some(_), [record]) => print_json(record),
                 _ => print_json(&records),
             };
         }
         if records.is_empty() {
-            println!("no campaigns in {}", args.db.display());
+            outln!("no campaigns in {}", args.db.display())?;
         }
         for r in &records {
             let s = &r.status;
@@ -173,7 +174,7 @@ pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
             for f in &s.failures {
                 table.row(format!("failed {}", f.job_id), f.error.clone());
             }
-            table.print();
+            table.print()?;
         }
         Ok(())
     })
@@ -212,7 +213,7 @@ fn write_csv(out: &mut impl Write, rows: &[ExportRow]) -> anyhow::Result<()> {
         header.push(format!("mean_{name}"));
         header.push(format!("std_{name}"));
     }
-    writeln!(out, "{}", header.join(","))?;
+    writeln!(out, "{}", header.iter().map(|h| csv::field(h)).collect::<Vec<_>>().join(","))?;
     for row in rows {
         let mut fields = vec![row.job_id.clone(), row.state.as_str().to_string(), row.seed.to_string()];
         fields.extend(keys.iter().map(|k| csv_value(row.parameters.get(k))));
@@ -239,12 +240,27 @@ fn write_csv(out: &mut impl Write, rows: &[ExportRow]) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// A grid value as a CSV field: numbers and strings bare, anything else as quoted JSON.
+/// A grid value as a CSV field: a string as its text, anything else as its JSON.
 fn csv_value(value: Option<&Value>) -> String {
     match value {
         None | Some(Value::Null) => String::new(),
-        Some(Value::String(s)) if !s.contains([',', '"', '\n']) => s.clone(),
-        Some(Value::Number(n)) => n.to_string(),
-        Some(other) => format!("\"{}\"", other.to_string().replace('"', "\"\"")),
+        Some(Value::String(s)) => csv::field(s),
+        Some(other) => csv::field(&other.to_string()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use serde_json::json;
+
+    use super::*;
+
+    #[test]
+    fn grid_values_become_csv_fields() {
+        assert_eq!(csv_value(Some(&json!(0.4))), "0.4");
+        assert_eq!(csv_value(Some(&json!("U7"))), "U7");
+        assert_eq!(csv_value(Some(&json!("a,b"))), "\"a,b\"");
+        assert_eq!(csv_value(Some(&json!({"fl": 0.5, "el": 0.6}))), r#""{""fl"":0.5,""el"":0.6}""#);
+        assert_eq!(csv_value(None), "");
     }
 }

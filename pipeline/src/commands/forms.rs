@@ -6,6 +6,7 @@ use solver::grain::simplify::simplify;
 use solver::grain::{EquivalentEllipsoid, FormDistribution, FormParameters, TriMesh, bonded_grain, ellipsoid_mass};
 
 use crate::cli::{DistributionArgs, FormsArgs};
+use crate::outln;
 use crate::output::{Table, number, print_json};
 
 pub fn run(args: &FormsArgs) -> anyhow::Result<()> {
@@ -36,13 +37,13 @@ pub fn run(args: &FormsArgs) -> anyhow::Result<()> {
         let form = FormParameters::new(lis[0], lis[1], lis[2]).context("--bonded")?;
         (bonded_record(&form)?, "bonded-sphere grain (Sun & Xiao, §2.4 and Appendix)".to_string())
     } else {
-        let d = args.distribution().expect("clap requires --lis, --mesh, --bonded or the distribution");
+        let d = args.distribution.given().expect("clap requires --lis, --mesh, --bonded or the distribution");
         (distribution_record(&d)?, "form distribution (§7.1, §7.3)".to_string())
     };
     if args.json {
         return print_json(&record);
     }
-    println!("{title}");
+    outln!("{title}")?;
     let mut table = Table::default();
     for (key, value) in &record {
         match value {
@@ -78,7 +79,7 @@ pub fn run(args: &FormsArgs) -> anyhow::Result<()> {
             other => table.row(key, other.to_string()),
         };
     }
-    table.print();
+    table.print()?;
     Ok(())
 }
 

@@ -13,7 +13,7 @@ use solver::packing::{Packing, PackingResult, Phase};
 
 use crate::cli::PackArgs;
 use crate::output::{Table, number, print_json};
-use crate::spec::{Experiment, JobSpec, read_job};
+use crate::spec::{JobSpec, read_job};
 use crate::vtk;
 
 /// Steps between progress updates: 0.05 s of simulated time at the paper's Δt.
@@ -30,7 +30,7 @@ struct ResultFile<'a> {
     simulated_time: f64,
     steps: u64,
     wall_time: f64,
-    experiment: Option<Experiment>,
+    experiment: Option<analysis::Experiment>,
     statistics: Map<String, Value>,
     profile: &'a [solver::porosity::ProfilePoint],
 }
@@ -69,7 +69,7 @@ pub fn run(args: &PackArgs) -> anyhow::Result<()> {
         .row("simulated time", format!("{:.3} s in {} steps", record.simulated_time, record.steps))
         .row("wall time", format!("{:.1} s", record.wall_time))
         .row("output", out.display().to_string());
-    table.print();
+    table.print()?;
     Ok(())
 }
 

@@ -3,7 +3,8 @@
 
 use std::path::Path;
 
-use anyhow::{Context, anyhow, bail};
+use analysis::csv::read_columns;
+use anyhow::{Context, bail};
 use serde::Serialize;
 use solver::porosity::{PorositySettings, ProfilePoint, evaluate};
 
@@ -22,32 +23,13 @@ struct Evaluation {
 
 /// (z, r) of every row; the header must name columns z and r (x and y may be present).
 fn read_spheres(path: &Path) -> anyhow::Result<Vec<(f64, f64)>> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
-    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
-    let (_, header) = lines.next().ok_or_else(|| anyhow!("{}: empty file", path.display()))?;
-    let columns: Vec<&str> = header.split(',').map(str::trim).collect();
-    let find = |name: &str| {
-        columns
-            .iter()
-            .position(|c| *c == name)
-            .ok_or_else(|| anyhow!("{}: line 1: no column '{name}' (expected a header x,y,z,r)", path.display()))
-    };
-    let (iz, ir) = (find("z")?, find("r")?);
-    let mut spheres = Vec::new();
-    for (n, line) in lines {
-        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-        let value = |i: usize, name: &str| -> anyhow::Result<f64> {
-            let raw =
-                fields.get(i).ok_or_else(|| anyhow!("{}: line {}: missing column '{name}'", path.display(), n + 1))?;
-            raw.parse().map_err(|_| anyhow!("{}: line {}: {name} = '{raw}' is not a number", path.display(), n + 1))
-        };
-        let (z, r) = (value(iz, "z")?, value(ir, "r")?);
-        if !(r > 0.0 && r.is_finite() && z.is_finite()) {
-            bail!("{}: line {}: r must be a positive number and z finite", path.display(), n + 1);
-        }
-        spheres.push((z, r));
-    }
-    Ok(spheres)
+    read_columns(path, &["z", "r"])?
+        .into_iter()
+        .map(|(line, values)| match values[..] {
+            [z, r] if r > 0.0 && r.is_finite() && z.is_finite() => Ok((z, r)),
+            _ => bail!("{}, line {line}: r must be a positive number and z finite", path.display()),
+        })
+        .collect()
 }
 
 pub fn run(args: &PorosityArgs) -> anyhow::Result<()> {
@@ -83,6 +65,6 @@ pub fn run(args: &PorosityArgs) -> anyhow::Result<()> {
         .row("evaluated", format!("{} m – {} m", number(evaluation.z_minus), number(evaluation.z_plus)))
         .row("surface", format!("{} m", number(evaluation.surface)))
         .row("particles", evaluation.particles.to_string());
-    table.print();
+    table.print()?;
     Ok(())
 }

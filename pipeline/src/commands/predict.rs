@@ -44,7 +44,7 @@ pub fn run(args: &PredictArgs) -> anyhow::Result<()> {
         ),
     };
     let mut warnings = Vec::new();
-    let distribution = args.distribution();
+    let distribution = args.distribution.given();
     let input = match (distribution.as_ref(), args.fl.zip(args.el), &args.grains) {
         (Some(d), _, _) => {
             if kind == Some(PaperModelKind::SingleForm) {
@@ -106,7 +106,7 @@ pub fn run(args: &PredictArgs) -> anyhow::Result<()> {
         table.row(k.as_str(), number(*v));
     }
     table.row("porosity", format!("{:.4}", output.porosity));
-    table.print();
+    table.print()?;
     for w in &output.warnings {
         eprintln!("warning: {w}");
     }

@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 use solver::grain::{FormDistribution, FormMoments, SieveCurve};
 
 use crate::cli::{SampleFormsArgs, SampleSizesArgs};
+use crate::outln;
 use crate::output::{Table, number, print_json};
 
 #[derive(Serialize)]
@@ -24,10 +25,10 @@ struct SampledForms {
 pub fn forms(args: &SampleFormsArgs) -> anyhow::Result<()> {
     let d = &args.distribution;
     let dist = FormDistribution::new(d.mu_fl, d.sigma_fl, d.mu_el, d.sigma_el)?;
-    let sampler = dist.sampler();
-    let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
+    let sampler = dist.sampler()?;
+    let mut rng = ChaCha8Rng::seed_from_u64(args.draw.seed);
     let (mut fl, mut el, mut eq) = (Moments::default(), Moments::default(), Moments::default());
-    for _ in 0..args.count {
+    for _ in 0..args.draw.count {
         let (f, e) = sampler.sample_flatness_elongation(&mut rng);
         fl.add(f);
         el.add(e);
@@ -41,19 +42,20 @@ pub fn forms(args: &SampleFormsArgs) -> anyhow::Result<()> {
         mean_eq: eq.mean(),
         std_eq: eq.std(),
     };
-    let result = SampledForms { count: args.count, seed: args.seed, sampled, expected: dist.truncated_moments() };
-    if args.json {
+    let result =
+        SampledForms { count: args.draw.count, seed: args.draw.seed, sampled, expected: dist.truncated_moments() };
+    if args.draw.json {
         return print_json(&result);
     }
-    println!("{} grains, seed {} (std: population standard deviation)", args.count, args.seed);
-    println!("{:<4} {:>10} {:>10} {:>14} {:>14}", "", "mean", "std", "expected mean", "expected std");
+    outln!("{} grains, seed {} (std: population standard deviation)", args.draw.count, args.draw.seed)?;
+    outln!("{:<4} {:>10} {:>10} {:>14} {:>14}", "", "mean", "std", "expected mean", "expected std")?;
     let e = &result.expected;
     for (name, m, s, em, es) in [
         ("FL", sampled.mean_fl, sampled.std_fl, e.mean_fl, e.std_fl),
         ("EL", sampled.mean_el, sampled.std_el, e.mean_el, e.std_el),
         ("EQ", sampled.mean_eq, sampled.std_eq, e.mean_eq, e.std_eq),
     ] {
-        println!("{name:<4} {m:>10.5} {s:>10.5} {em:>14.5} {es:>14.5}");
+        outln!("{name:<4} {m:>10.5} {s:>10.5} {em:>14.5} {es:>14.5}")?;
     }
     Ok(())
 }
@@ -116,10 +118,10 @@ pub fn sizes(args: &SampleSizesArgs) -> anyhow::Result<()> {
         (None, None) => unreachable!("clap requires --case or --sieves"),
     };
     let sampler = curve.sampler();
-    let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
+    let mut rng = ChaCha8Rng::seed_from_u64(args.draw.seed);
     let mut mass = vec![0.0; curve.classes()];
     let mut grains = vec![0u64; curve.classes()];
-    for _ in 0..args.count {
+    for _ in 0..args.draw.count {
         let (class, d) = sampler.sample(&mut rng);
         mass[class] += d.powi(3);
         grains[class] += 1;
@@ -127,27 +129,24 @@ pub fn sizes(args: &SampleSizesArgs) -> anyhow::Result<()> {
     let total: f64 = mass.iter().sum();
     let result = SampledSizes {
         curve: name,
-        count: args.count,
-        seed: args.seed,
+        count: args.draw.count,
+        seed: args.draw.seed,
         sieves: curve.sieves().to_vec(),
         prescribed: curve.fractions().to_vec(),
         mass_fractions: mass.iter().map(|m| m / total).collect(),
         grains,
     };
-    if args.json {
+    if args.draw.json {
         return print_json(&result);
     }
-    println!("{}: {} grains, seed {}", result.curve, result.count, result.seed);
-    println!("{:>18} {:>11} {:>9} {:>9}", "class (mm)", "prescribed", "sampled", "grains");
+    outln!("{}: {} grains, seed {}", result.curve, result.count, result.seed)?;
+    outln!("{:>18} {:>11} {:>9} {:>9}", "class (mm)", "prescribed", "sampled", "grains")?;
     for i in 0..curve.classes() {
         let class = format!("{:.2}–{:.2}", result.sieves[i] * 1e3, result.sieves[i + 1] * 1e3);
-        println!(
-            "{class:>18} {:>11.4} {:>9.4} {:>9}",
-            result.prescribed[i], result.mass_fractions[i], result.grains[i]
-        );
+        outln!("{class:>18} {:>11.4} {:>9.4} {:>9}", result.prescribed[i], result.mass_fractions[i], result.grains[i])?;
     }
     let mut table = Table::default();
     table.row("largest sieve (m)", number(curve.largest_sieve()));
-    table.print();
+    table.print()?;
     Ok(())
 }

@@ -7,6 +7,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::contact::ContactGeometry;
+use super::material::Material;
 
 /// κ = 2(1 − ν)/(2 − ν), Eq. 13.
 pub fn tangential_stiffness_ratio(poisson_ratio: f64) -> f64 {
@@ -14,14 +15,15 @@ pub fn tangential_stiffness_ratio(poisson_ratio: f64) -> f64 {
 }
 
 /// How k_n and d_n follow from e_n and T_c.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Calibration {
     /// Eq. 11 as printed: exact for the continuous equation of motion. Integrated with the
     /// semi-implicit Euler scheme at T_c/Δt = 40 collisions rebound with e ≈ 0.084–0.095, not 0.1.
     Continuous,
-    /// Eq. 11 solved for the semi-implicit Euler map of step Δt instead of the continuous motion,
-    /// so that a simulated binary collision rebounds with exactly e_n after exactly T_c.
-    Discrete { time_step: f64 },
+    /// Eq. 11 solved for the semi-implicit Euler map of the simulation's step Δt instead of the
+    /// continuous motion, so that a simulated binary collision rebounds with exactly e_n after
+    /// exactly T_c.
+    Discrete,
 }
 
 /// Parameters of the linear spring-dashpot law, per unit effective mass so that each pair
@@ -50,19 +52,15 @@ pub struct ContactHistory {
 }
 
 impl LinearSpringDashpot {
-    pub fn new(
-        restitution: f64,
-        collision_time: f64,
-        poisson_ratio: f64,
-        friction: f64,
-        calibration: Calibration,
-    ) -> Self {
+    /// The law of a material integrated with time step Δt = `time_step`.
+    pub fn new(material: &Material, calibration: Calibration, time_step: f64) -> Self {
+        let Material { restitution, collision_time, poisson_ratio, friction, .. } = *material;
         let (stiffness_per_mass, damping_per_mass) = match calibration {
             Calibration::Continuous => {
                 let ln_e = restitution.ln();
                 ((std::f64::consts::PI.powi(2) + ln_e * ln_e) / collision_time.powi(2), -2.0 * ln_e / collision_time)
             }
-            Calibration::Discrete { time_step } => {
+            Calibration::Discrete => {
                 // Per step, the map x'' = −ω² x − 2γ x' has eigenvalues r e^{±iθ} with
                 // r² = 1 − 2γΔt and 2r cos θ = 2 − 2γΔt − ω²Δt². Contact lasts N = T_c/Δt steps
                 // when θ = π/N, and the rebound velocity is r^N times the impact velocity.

@@ -17,6 +17,7 @@ use super::contact;
 use super::contact::{Mode, PairCache};
 use super::contact_law::{Calibration, ContactHistory, LinearSpringDashpot};
 use super::domain::Domain;
+use super::material::Material;
 use super::neighbours::{BuildScratch, NeighbourList};
 use super::shape::{Pose, Shape};
 use crate::SolverError;
@@ -32,16 +33,7 @@ pub const MAX_RELATIVE_OVERLAP: f64 = 0.5;
 /// Material and numerical constants of a simulation (§4.2).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Settings {
-    /// Grain density ρ_p (kg/m³).
-    pub density: f64,
-    /// Fluid density ρ_f (kg/m³); buoyancy reduces the weight to (ρ_p − ρ_f) V g (Eq. 10).
-    pub fluid_density: f64,
-    /// Gravitational acceleration vector (m/s²), (0, 0, −g) for the paper's setups.
-    pub gravity: Vector3<f64>,
-    pub restitution: f64,
-    pub collision_time: f64,
-    pub poisson_ratio: f64,
-    pub friction: f64,
+    pub material: Material,
     pub time_step: f64,
     /// Verlet skin of the neighbour list (m).
     pub skin: f64,
@@ -184,23 +176,17 @@ struct Pipeline {
 
 impl Simulation {
     pub fn new(domain: Domain, settings: Settings) -> Result<Self, SolverError> {
-        if settings.collision_time / settings.time_step < MIN_STEPS_PER_COLLISION {
+        if settings.material.collision_time / settings.time_step < MIN_STEPS_PER_COLLISION {
             return Err(SolverError::TimeStepTooLarge {
                 time_step: settings.time_step,
-                collision_time: settings.collision_time,
+                collision_time: settings.material.collision_time,
             });
         }
         Ok(Self {
             bodies: Bodies::default(),
             domain,
             settings,
-            law: LinearSpringDashpot::new(
-                settings.restitution,
-                settings.collision_time,
-                settings.poisson_ratio,
-                settings.friction,
-                settings.calibration,
-            ),
+            law: LinearSpringDashpot::new(&settings.material, settings.calibration, settings.time_step),
             neighbours: NeighbourList::new(settings.skin),
             walls: Vec::new(),
             time: 0.0,
@@ -230,7 +216,7 @@ impl Simulation {
 
     pub fn add_body(&mut self, body: NewBody) -> usize {
         self.walls.push(Vec::new());
-        self.bodies.push(body, self.settings.density)
+        self.bodies.push(body, self.settings.material.density)
     }
 
     /// Advances the simulation by one time step Δt.
@@ -384,7 +370,7 @@ impl Simulation {
         let pair_forces = &self.pipeline.pair_forces;
         let poses = &self.pipeline.poses;
         let dt = settings.time_step;
-        let weight_per_volume = (settings.density - settings.fluid_density) * settings.gravity;
+        let weight_per_volume = settings.material.weight_per_volume();
         let shaking = self.shaking.map_or(0.0, |s| s.acceleration(self.time));
         let damping = self.damping.map(|c| c.powf(dt));
         let b = &mut self.bodies;

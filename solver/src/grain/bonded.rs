@@ -13,9 +13,10 @@
 use std::f64::consts::PI;
 use std::fmt;
 
-use nalgebra::{Matrix3, Rotation3, SymmetricEigen, Vector3};
+use nalgebra::{Matrix3, Rotation3, Vector3};
 use serde::{Deserialize, Serialize};
 
+use super::ellipsoid::principal_frame;
 use super::form::{FormError, FormParameters};
 use super::mesh::MassProperties;
 
@@ -191,20 +192,6 @@ pub fn bonded_grain(form: &FormParameters) -> Result<BondedGrain, FormError> {
         rotation,
         center_of_mass: com,
     })
-}
-
-/// Principal axes of an inertia tensor as the columns of a proper rotation, and the principal
-/// moments, ascending. The moments are the eigenvalues themselves, so equal moments (a rod, a
-/// single sphere) cannot come out of order by rounding.
-fn principal_frame(inertia: &Matrix3<f64>) -> (Rotation3<f64>, Vector3<f64>) {
-    let eigen = SymmetricEigen::new(*inertia);
-    let mut order = [0usize, 1, 2];
-    order.sort_by(|&p, &q| eigen.eigenvalues[p].total_cmp(&eigen.eigenvalues[q]));
-    let mut axes = Matrix3::from_columns(&order.map(|k| eigen.eigenvectors.column(k).into_owned()));
-    if axes.determinant() < 0.0 {
-        axes.set_column(2, &(-axes.column(2)));
-    }
-    (Rotation3::from_matrix_unchecked(axes), Vector3::from(order.map(|k| eigen.eigenvalues[k])))
 }
 
 /// Volume, centre of mass and inertia tensor (per unit density, about the centre of mass) of a

@@ -25,6 +25,10 @@ pub enum DistributionError {
     Sigma { name: &'static str, value: f64 },
 }
 
+/// The form distribution of the Rhine gravel (Table 2): μ_FL, σ_FL, μ_EL, σ_EL.
+pub const RHINE_FORMS: FormDistribution =
+    FormDistribution { mu_fl: 0.647, sigma_fl: 0.175, mu_el: 0.682, sigma_el: 0.139 };
+
 /// Independent normal distributions of flatness FL and elongation EL (nominal parameters, the
 /// hatted μ̂, σ̂ of §7.1).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -92,9 +96,13 @@ impl FormDistribution {
         }
     }
 
-    pub fn sampler(&self) -> FormSampler {
-        let normal = |mu: f64, sigma: f64| Normal::new(mu, sigma).expect("validated: finite σ ≥ 0");
-        FormSampler { fl: normal(self.mu_fl, self.sigma_fl), el: normal(self.mu_el, self.sigma_el) }
+    /// A sampler of this distribution; the parameters are checked as by [`FormDistribution::new`],
+    /// since the fields are public and a mean outside [0.1, 1] would never be drawn.
+    pub fn sampler(&self) -> Result<FormSampler, DistributionError> {
+        let d = Self::new(self.mu_fl, self.sigma_fl, self.mu_el, self.sigma_el)?;
+        let normal =
+            |name, mu, sigma| Normal::new(mu, sigma).map_err(|_| DistributionError::Sigma { name, value: sigma });
+        Ok(FormSampler { fl: normal("sigma_fl", d.mu_fl, d.sigma_fl)?, el: normal("sigma_el", d.mu_el, d.sigma_el)? })
     }
 }
 

@@ -24,7 +24,7 @@ pub use form::{
     FactorValue, FormError, FormFactor, FormFactors, FormParameters, FormStatistic, Undefined, feature_names,
     form_statistics,
 };
-pub use form_distribution::{DistributionError, FormDistribution, FormMoments, FormSampler};
+pub use form_distribution::{DistributionError, FormDistribution, FormMoments, FormSampler, RHINE_FORMS};
 pub use library::{MeshLibrary, folder_meshes, rhine_meshes};
 pub use mesh::{MassProperties, MeshDefect, MeshError, TriMesh};
 pub use simplify::{Simplified, SimplifyError, simplify};

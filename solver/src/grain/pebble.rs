@@ -6,23 +6,17 @@ use nalgebra::Vector3;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::form_distribution::FormDistribution;
+use super::form_distribution::RHINE_FORMS;
 use super::mesh::{MeshDefect, TriMesh};
-
-/// Face bound of the paper's simplified meshes (n_F ≤ 300, §5.2.1).
-pub const DEFAULT_MAX_FACES: usize = 300;
-
-/// The Rhine form distribution (Table 2, Fig. 2): pebbles get realistic own forms.
-/// The form distribution of the Rhine gravel of Table 2 (μ_FL, σ_FL, μ_EL, σ_EL).
-pub const RHINE_FORMS: FormDistribution =
-    FormDistribution { mu_fl: 0.647, sigma_fl: 0.175, mu_el: 0.682, sigma_el: 0.139 };
 
 /// One pebble. A hull of n points in general position has at most 2n − 4 triangles, so
 /// n = (max_faces + 4)/2 points keep the face count within the bound.
 pub fn pebble(seed: u64, max_faces: usize) -> Result<TriMesh, MeshDefect> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let points = (max_faces.max(8) + 4) / 2;
-    let (fl, el) = RHINE_FORMS.sampler().sample_flatness_elongation(&mut rng);
+    // Pebbles get the realistic own forms of the Rhine gravel (Table 2, Fig. 2).
+    let forms = RHINE_FORMS.sampler().expect("Table 2's distribution lies in the admissible ranges");
+    let (fl, el) = forms.sample_flatness_elongation(&mut rng);
     let semi_axes = Vector3::new(1.0, el, el * fl);
 
     // Smooth lumps: a few broad bumps and dents of the radius.

@@ -37,6 +37,9 @@ use thiserror::Error;
 
 use super::mesh::{MeshDefect, TriMesh};
 
+/// Face bound of the paper's simplified meshes, n_F ≤ 300 (§5.2.1, Table 4).
+pub const DEFAULT_MAX_FACES: usize = 300;
+
 /// Directions of the quadric whose curvature is below this fraction of the largest are treated
 /// as flat: the contracted vertex stays at the edge midpoint along them (Lindstrom 2000 uses
 /// the same kind of relative cut-off).

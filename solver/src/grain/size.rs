@@ -80,8 +80,10 @@ impl Table3Case {
         TABLE3.iter().find(|c| c.name.eq_ignore_ascii_case(name))
     }
 
+    /// The case's sieve curve, which remembers the case.
     pub fn sieve_curve(&self) -> SieveCurve {
-        SieveCurve::new(TABLE3_SIEVES.to_vec(), self.fractions.to_vec()).expect("Table 3 rows are valid sieve curves")
+        let sieves = TABLE3_SIEVES.to_vec();
+        SieveCurve { sieves, fractions: self.fractions.to_vec(), case: Some(self.name.to_string()) }
     }
 }
 
@@ -106,6 +108,8 @@ pub enum SizeError {
 pub struct SieveCurve {
     sieves: Vec<f64>,
     fractions: Vec<f64>,
+    /// The Table 3 case this curve is, when it was named as one.
+    case: Option<String>,
 }
 
 impl SieveCurve {
@@ -129,7 +133,7 @@ impl SieveCurve {
         if (sum - 1.0).abs() > FRACTION_SUM_TOLERANCE {
             return Err(SizeError::Sum(sum));
         }
-        Ok(Self { sieves, fractions })
+        Ok(Self { sieves, fractions, case: None })
     }
 
     /// A Table 3 case by name (case-insensitive).
@@ -147,6 +151,21 @@ impl SieveCurve {
 
     pub fn classes(&self) -> usize {
         self.fractions.len()
+    }
+
+    /// The Table 3 case the curve was named as, if it was.
+    pub fn case(&self) -> Option<&'static Table3Case> {
+        Table3Case::find(self.case.as_deref()?)
+    }
+
+    /// The lower sieve of the first class with grains: no grain is smaller.
+    pub fn smallest_in_use(&self) -> f64 {
+        self.sieves[self.fractions.iter().position(|&f| f > 0.0).unwrap_or(0)]
+    }
+
+    /// The upper sieve of the last class with grains: no grain is larger.
+    pub fn largest_in_use(&self) -> f64 {
+        self.sieves[self.fractions.iter().rposition(|&f| f > 0.0).unwrap_or(self.classes() - 1) + 1]
     }
 
     /// The largest sieve, h_pd of §6.1.

@@ -1,7 +1,10 @@
-//! Meshes built by hand for the tests.
+//! Meshes, settings and packing specs shared by the solver's tests.
 #![allow(dead_code)]
 
 use nalgebra::Vector3;
+use solver::dem::{Calibration, Domain, Material, Settings, Simulation};
+use solver::grain::SieveCurve;
+use solver::packing::{DomainKind, PackingSpec, ShapeKind};
 
 /// An axis-aligned box with sides (a, b, c) centred at the origin, outward normals, as
 /// (vertices, triangles).
@@ -56,19 +59,52 @@ pub fn rhine_mesh_path(k: usize) -> std::path::PathBuf {
 
 /// The paper's material and time step (§4.2) with the given restitution, friction and gravity
 /// (gravity tilted for slopes), a 1 mm skin and the discrete calibration.
-pub fn settings(restitution: f64, friction: f64, gravity: Vector3<f64>) -> solver::dem::Settings {
-    solver::dem::Settings {
-        density: 2650.0,
-        fluid_density: 1000.0,
-        gravity,
-        restitution,
-        collision_time: 2e-4,
-        poisson_ratio: 0.22,
-        friction,
-        time_step: 5e-6,
-        skin: 1e-3,
-        calibration: solver::dem::Calibration::Discrete { time_step: 5e-6 },
+pub fn settings(restitution: f64, friction: f64, gravity: Vector3<f64>) -> Settings {
+    let material = Material { restitution, friction, gravity, ..Material::default() };
+    Settings { material, time_step: 5e-6, skin: 1e-3, calibration: Calibration::Discrete }
+}
+
+/// A bed of 5.6–8 mm grains in a 4 cm periodic square 15 cm high, given a generation spacing
+/// and a shaking duration, with 5 s of simulated time to settle; the paper's setup otherwise.
+pub fn small_bed(shape: ShapeKind, mass: f64, spacing: f64, shaking_duration: f64) -> PackingSpec {
+    let mut spec = PackingSpec::paper(DomainKind::Periodic);
+    spec.domain = Domain::Periodic { width: 0.04 };
+    spec.height = Some(0.15);
+    spec.grains.shape = shape;
+    spec.grains.size = SieveCurve::new(vec![5.6e-3, 8e-3], vec![1.0]).unwrap();
+    spec.grains.mass = mass;
+    spec.process.spacing = Some(spacing);
+    spec.process.shaking_duration = shaking_duration;
+    spec.process.max_time = Some(5.0);
+    spec
+}
+
+/// Steps until the bodies have separated after their first contact; returns the contact steps.
+pub fn collide(sim: &mut Simulation) -> u64 {
+    let (mut steps, mut touched) = (0, false);
+    for _ in 0..100_000 {
+        sim.step().unwrap();
+        if sim.contacts > 0 {
+            touched = true;
+            steps += 1;
+        } else if touched {
+            return steps;
+        }
     }
+    panic!("the bodies never met");
+}
+
+/// Steps for `time` s; returns body 0's displacement along x and its acceleration from
+/// x = x₀ + v₀ t + a t²/2.
+pub fn slide_x(sim: &mut Simulation, time: f64) -> (f64, f64) {
+    let (x0, v0) = (sim.bodies.position[0].x, sim.bodies.velocity[0].x);
+    let n = (time / sim.settings.time_step) as usize;
+    for _ in 0..n {
+        sim.step().unwrap();
+    }
+    let t = n as f64 * sim.settings.time_step;
+    let dx = sim.bodies.position[0].x - x0;
+    (dx, 2.0 * (dx - v0 * t) / (t * t))
 }
 
 /// Total linear momentum and angular momentum about the origin of all bodies.

@@ -5,7 +5,7 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 use serde_json::{Map, json};
-use store::{GrainStatistic, JobResult, JobState, NewJob, ProfilePoint, Store};
+use store::{GrainStatistic, JobResult, JobState, NewJob, Store};
 
 pub const CAMPAIGN: &str = "rhine-u1";
 pub const CAMPAIGN_SPEC: &str = "name: rhine-u1\ngrid:\n  grains.form.mu_fl: [0.4, 0.6]\n";
@@ -14,7 +14,8 @@ pub fn db_path(dir: &tempfile::TempDir) -> PathBuf {
     dir.path().join("sedpack.db")
 }
 
-/// Job `index` of a grid over mu_fl, as the pipeline would describe it.
+/// Job `index` of a grid over mu_fl, as the pipeline would describe it; every other job is
+/// compared with a measurement, every fourth with its spread.
 pub fn job(index: usize) -> NewJob {
     let mu_fl = 0.4 + 0.01 * index as f64;
     let seed = index as u64 % 3 + 1;
@@ -23,9 +24,12 @@ pub fn job(index: usize) -> NewJob {
     parameters.insert("grains.size".into(), json!("U1"));
     NewJob {
         id: format!("job-{index:04}"),
+        format: 1,
         spec: json!({"name": CAMPAIGN, "grains": {"size": "U1", "form": {"mu_fl": mu_fl}}, "seed": seed}),
         seed,
         parameters,
+        experiment_porosity: index.is_multiple_of(2).then_some(0.371),
+        experiment_std: index.is_multiple_of(4).then_some(0.001),
     }
 }
 
@@ -38,7 +42,7 @@ pub fn result(porosity: f64) -> JobResult {
         porosity,
         z_minus: 0.002,
         z_plus: 0.041,
-        profile: vec![ProfilePoint { z: 0.0005, n: 0.52 }, ProfilePoint { z: 0.0015, n: porosity }],
+        profile: json!([{"z": 0.0005, "n": 0.52}, {"z": 0.0015, "n": porosity}]),
         particles: 1234,
         simulated_time: 7.5,
         steps: 1_500_000,

@@ -1,8 +1,13 @@
 //! The packing protocol of §4.3: grains created layer by layer on a hexahedral grid in the upper
 //! part of the domain, shaken horizontally (Eq. 14) from the start until t_s after the last
 //! creation, then damped (Eq. 15) until the mass-averaged height settles; finally the porosity of
-//! §4.4.
+//! §4.4. What a packing is, with the paper's defaults and rules, is `PackingSpec` (spec.rs).
 
+mod spec;
+
+pub use spec::{Derived, DomainKind, FormSpec, GrainSpec, PackingSpec, Process, ShapeKind, SpecError, in_range};
+
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use nalgebra::Vector3;
@@ -12,115 +17,17 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::SolverError;
-use std::sync::Arc;
-
 use crate::dem::shape::{ConvexPolyhedron, Polyhedron};
-use crate::dem::{Calibration, Domain, NewBody, Settings, Shaking, Shape, Simulation, uniform_rotation};
+use crate::dem::{NewBody, Settings, Shape, Simulation, uniform_rotation};
 use crate::grain::{
-    FormDistribution, FormParameters, FormStatistic, MeshLibrary, SieveCurve, SizeSampler, bonded_grain,
-    form_statistics,
+    FormParameters, FormSampler, FormStatistic, MeshLibrary, SizeSampler, bonded_grain, form_statistics,
 };
 use crate::porosity::{self, Porosity, PorosityError, PorositySettings};
 
-/// Material constants of §4.2.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Material {
-    pub density: f64,
-    pub fluid_density: f64,
-    pub gravity: f64,
-    pub restitution: f64,
-    pub collision_time: f64,
-    pub poisson_ratio: f64,
-    pub friction: f64,
-}
-
-impl Default for Material {
-    fn default() -> Self {
-        Self {
-            density: 2650.0,
-            fluid_density: 1000.0,
-            gravity: 9.81,
-            restitution: 0.1,
-            collision_time: 2e-4,
-            poisson_ratio: 0.22,
-            friction: 0.5,
-        }
-    }
-}
-
-/// The shape family of the grains.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum ShapeKind {
-    Sphere,
-    Ellipsoid,
-    /// The bonded-sphere grain of Sun & Xiao (§2.4) built for each grain's L, I, S.
-    BondedSpheres,
-    /// A convex polyhedron: a mesh of the library rescaled to the grain's L, I, S (Fig. 5).
-    Mesh,
-}
-
-/// How each grain's form is chosen.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum FormSpec {
-    /// One flatness and elongation for every grain.
-    Single { fl: f64, el: f64 },
-    /// FL and EL drawn per grain (§7.1).
-    Distribution(FormDistribution),
-    /// Each mesh keeps its own form, scaled to the grain's size (§5.1).
-    Own,
-}
-
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct GrainSpec {
-    pub shape: ShapeKind,
-    pub size: SieveCurve,
-    /// Total mass generated, m_tot (kg).
-    pub mass: f64,
-    pub form: FormSpec,
-    /// The meshes of `ShapeKind::Mesh`, drawn from uniformly (§3.2).
-    pub meshes: Option<MeshLibrary>,
-}
-
-/// Process parameters of §4.3 (generation, shaking, damping, convergence).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Process {
-    /// Grid spacing h_g of the generation (m).
-    pub spacing: f64,
-    /// Initial speed u_p^init (m/s).
-    pub velocity: f64,
-    pub shaking: Shaking,
-    /// Shaking continues this long after the last grain was created, t_s (s).
-    pub shaking_duration: f64,
-    /// Damping coefficient c_d of Eq. 15.
-    pub damping: f64,
-    /// Converged once ⟨z⟩ changes by less than this (m) …
-    pub height_change: f64,
-    /// … over this interval (s).
-    pub interval: f64,
-    /// The packing fails if not converged by this simulated time (s).
-    pub max_time: f64,
-}
-
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct PackingSpec {
-    pub domain: Domain,
-    /// Domain height H (m); grains are created in [0.6, 1]·H.
-    pub height: f64,
-    pub grains: GrainSpec,
-    pub material: Material,
-    pub time_step: f64,
-    pub calibration: Calibration,
-    pub process: Process,
-    /// Slice height, cut-off porosity and trim of §4.4; a trim of None means the paper's
-    /// choice: the largest sieve (periodic domain), 0 (cylinder).
-    pub slice: f64,
-    pub cutoff: f64,
-    pub trim: Option<f64>,
-    pub seed: u64,
-}
-
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum PackingError {
+    #[error(transparent)]
+    Spec(#[from] SpecError),
     #[error(transparent)]
     Solver(#[from] SolverError),
     #[error(transparent)]
@@ -136,6 +43,8 @@ pub enum PackingError {
     Unfinished,
     #[error("grains.meshes: {0}")]
     Meshes(String),
+    #[error("grains.form: {0}")]
+    Form(String),
 }
 
 /// The stage of the protocol.
@@ -193,6 +102,7 @@ pub struct PackingResult {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Packing {
     spec: PackingSpec,
+    derived: Derived,
     pub simulation: Simulation,
     rng: ChaCha8Rng,
     phase: Phase,
@@ -214,27 +124,20 @@ pub struct Packing {
 const GENERATION_CHECK_STEPS: u64 = 100;
 
 impl Packing {
+    /// A packing of a checked spec, ready to generate its first grains.
     pub fn new(spec: PackingSpec) -> Result<Self, PackingError> {
-        let m = &spec.material;
-        let smallest =
-            spec.grains.size.sieves()[spec.grains.size.fractions().iter().position(|&f| f > 0.0).unwrap_or(0)];
+        spec.check()?;
+        let derived = spec.derived();
         let settings = Settings {
-            density: m.density,
-            fluid_density: m.fluid_density,
-            gravity: Vector3::new(0.0, 0.0, -m.gravity),
-            restitution: m.restitution,
-            collision_time: m.collision_time,
-            poisson_ratio: m.poisson_ratio,
-            friction: m.friction,
+            material: spec.material,
             time_step: spec.time_step,
-            // A skin of 15 % of the smallest grain keeps neighbour lists for ~100 steps at 1 m/s.
-            skin: 0.15 * smallest,
+            skin: derived.skin,
             calibration: spec.calibration,
         };
         let simulation = Simulation::new(spec.domain, settings)?;
-        let grid = generation_grid(&spec);
+        let grid = generation_grid(&spec, &derived);
         if grid.is_empty() {
-            return Err(PackingError::NoGridPositions { spacing: spec.process.spacing });
+            return Err(PackingError::NoGridPositions { spacing: derived.spacing });
         }
         if spec.grains.shape == ShapeKind::Mesh && spec.grains.meshes.as_ref().is_none_or(|m| m.meshes.is_empty()) {
             return Err(PackingError::Meshes("a mesh packing needs at least one mesh".into()));
@@ -253,11 +156,16 @@ impl Packing {
             wall_time: Duration::ZERO,
             bases: Vec::new(),
             spec,
+            derived,
         })
     }
 
     pub fn spec(&self) -> &PackingSpec {
         &self.spec
+    }
+
+    pub fn derived(&self) -> &Derived {
+        &self.derived
     }
 
     /// Gives a packing restored from a checkpoint its meshes back (a checkpoint keeps only their
@@ -321,8 +229,8 @@ impl Packing {
                 Phase::Converged => return Ok(self.phase),
                 _ => {}
             }
-            if self.simulation.time > p.max_time {
-                return Err(PackingError::NotConverged(p.max_time));
+            if self.simulation.time > self.derived.max_time {
+                return Err(PackingError::NotConverged(self.derived.max_time));
             }
             self.simulation.shaking = (self.phase != Phase::Damping).then_some(p.shaking);
             self.simulation.damping = (self.phase == Phase::Damping).then_some(p.damping);
@@ -333,7 +241,7 @@ impl Packing {
 
     /// Whether every grain of the last set lies wholly below the generation region.
     fn last_set_left(&self) -> bool {
-        let floor = 0.6 * self.spec.height;
+        let floor = 0.6 * self.derived.height;
         let b = &self.simulation.bodies;
         (self.set_start..b.len()).all(|k| b.position[k].z + b.bounding_radius[k] < floor)
     }
@@ -343,8 +251,8 @@ impl Packing {
     fn generate_set(&mut self) -> Result<(), PackingError> {
         let spec = &self.spec;
         let sizes: SizeSampler = spec.grains.size.sampler();
-        let forms = match spec.grains.form {
-            FormSpec::Distribution(d) => Some(d.sampler()),
+        let forms: Option<FormSampler> = match spec.grains.form {
+            FormSpec::Distribution(d) => Some(d.sampler().map_err(|e| PackingError::Form(e.to_string()))?),
             FormSpec::Single { .. } | FormSpec::Own => None,
         };
         let meshes = spec.grains.meshes.as_ref().map_or(&[][..], |m| &m.meshes[..]);
@@ -378,7 +286,7 @@ impl Packing {
                 (ShapeKind::Sphere, _) => Shape::Sphere { radius: size / 2.0 },
                 (ShapeKind::Ellipsoid, _) => Shape::Ellipsoid { semi_axes: Vector3::new(form.l, form.i, form.s) / 2.0 },
                 (ShapeKind::BondedSpheres, _) => {
-                    Shape::from(&bonded_grain(&form).expect("sampled forms satisfy L ≥ I ≥ S > 0"))
+                    Shape::from(&bonded_grain(&form).map_err(|e| PackingError::Form(e.to_string()))?)
                 }
                 (ShapeKind::Mesh, Some(_)) => {
                     let base = self.bases[drawn.expect("a mesh was drawn")].clone();
@@ -424,11 +332,7 @@ impl Packing {
         let b = &self.simulation.bodies;
         let spheres: Vec<(f64, f64)> =
             (0..b.len()).map(|k| (b.position[k].z, b.shape[k].equivalent_radius())).collect();
-        let trim = self.spec.trim.unwrap_or(match self.spec.domain {
-            Domain::Periodic { .. } => self.spec.grains.size.largest_sieve(),
-            Domain::Cylinder { .. } => 0.0,
-        });
-        let settings = PorositySettings { slice: self.spec.slice, cutoff: self.spec.cutoff, trim };
+        let settings = PorositySettings { slice: self.spec.slice, cutoff: self.spec.cutoff, trim: self.derived.trim };
         let porosity = porosity::evaluate(&spheres, self.spec.domain.cross_section(), &settings)?;
         Ok(PackingResult {
             porosity,
@@ -442,21 +346,17 @@ impl Packing {
 }
 
 /// Grid positions of the generation region z ∈ [0.6, 1]·H, spacing h_g, centred horizontally.
-fn generation_grid(spec: &PackingSpec) -> Vec<Vector3<f64>> {
-    let h = spec.process.spacing;
+fn generation_grid(spec: &PackingSpec, derived: &Derived) -> Vec<Vector3<f64>> {
+    let (h, height) = (derived.spacing, derived.height);
     let l = spec.domain.width();
     let per_row = (l / h).floor() as usize;
-    let layers = (0.4 * spec.height / h).floor() as usize;
+    let layers = (0.4 * height / h).floor() as usize;
     let offset = (l - (per_row.max(1) - 1) as f64 * h) / 2.0;
     let mut grid = Vec::with_capacity(per_row * per_row * layers);
     for k in 0..layers {
         for j in 0..per_row {
             for i in 0..per_row {
-                let p = Vector3::new(
-                    offset + i as f64 * h,
-                    offset + j as f64 * h,
-                    0.6 * spec.height + (k as f64 + 0.5) * h,
-                );
+                let p = Vector3::new(offset + i as f64 * h, offset + j as f64 * h, 0.6 * height + (k as f64 + 0.5) * h);
                 if spec.domain.holds(p.x, p.y, h / 2.0) {
                     grid.push(p);
                 }

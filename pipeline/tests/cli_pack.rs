@@ -1,30 +1,9 @@
 //! End-to-end tests of `sedpack pack` and `sedpack porosity`, running the built binary.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
+use common::{fails, sedpack, write};
 use serde_json::Value;
-
-fn sedpack(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sedpack")).args(args).output().expect("sedpack runs")
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> String {
-    let path = dir.join(name);
-    std::fs::write(&path, text).unwrap();
-    path.to_str().unwrap().to_string()
-}
-
-/// The command fails with status 1 and one line on stderr containing every needle.
-fn fails(args: &[&str], needles: &[&str]) {
-    let out = sedpack(args);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
-    assert_eq!(stderr.trim_end().lines().count(), 1, "one line: {stderr}");
-    for n in needles {
-        assert!(stderr.contains(n), "'{stderr}' lacks '{n}'");
-    }
-}
 
 const SMALL_BED: &str = "name: small
 domain: {kind: periodic, width: 0.04, height: 0.15}

@@ -1,33 +1,8 @@
 //! End-to-end tests of `sedpack forms`, `sample` and `predict`, running the built binary.
 
-use std::process::{Command, Output};
+mod common;
 
-use serde_json::Value;
-
-fn sedpack(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sedpack")).args(args).output().expect("sedpack runs")
-}
-
-fn json(args: &[&str]) -> Value {
-    let out = sedpack(args);
-    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
-    serde_json::from_slice(&out.stdout).expect("one JSON object")
-}
-
-/// The command fails with exit code 1 and one line on stderr containing every `needle`.
-fn fails(args: &[&str], needles: &[&str]) {
-    let out = sedpack(args);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
-    assert_eq!(stderr.trim_end().lines().count(), 1, "one line: {stderr}");
-    for n in needles {
-        assert!(stderr.contains(n), "{args:?}: '{stderr}' lacks '{n}'");
-    }
-}
-
-fn repo(path: &str) -> String {
-    format!("{}/../{path}", env!("CARGO_MANIFEST_DIR"))
-}
+use common::{fails, json, repo, sedpack};
 
 #[test]
 fn forms_lis_prints_table1_factors() {
@@ -119,7 +94,7 @@ fn forms_of_a_distribution_give_equancy_statistics() {
 
 #[test]
 fn sample_forms_matches_the_expected_truncated_moments() {
-    let v = json(&[
+    let args = [
         "sample",
         "forms",
         "--mu-fl",
@@ -135,7 +110,8 @@ fn sample_forms_matches_the_expected_truncated_moments() {
         "--seed",
         "4",
         "--json",
-    ]);
+    ];
+    let v = json(&args);
     for key in ["FL", "EL", "EQ"] {
         let got = v[format!("mean_{key}")].as_f64().unwrap();
         let want = v["expected"][format!("mean_{key}")].as_f64().unwrap();
@@ -143,27 +119,7 @@ fn sample_forms_matches_the_expected_truncated_moments() {
         // 5 standard errors of the mean of 50,000 draws.
         assert!((got - want).abs() < 5.0 * sd / 50_000f64.sqrt(), "{key}: {got} vs {want}");
     }
-    assert_eq!(
-        v,
-        json(&[
-            "sample",
-            "forms",
-            "--mu-fl",
-            "0.5",
-            "--sigma-fl",
-            "0.2",
-            "--mu-el",
-            "0.7",
-            "--sigma-el",
-            "0.15",
-            "--count",
-            "50000",
-            "--seed",
-            "4",
-            "--json"
-        ]),
-        "same seed, same sample"
-    );
+    assert_eq!(v, json(&args), "same seed, same sample");
 }
 
 #[test]

@@ -1,47 +1,18 @@
 //! End-to-end tests of campaigns: `sedpack run`, `resume`, `status`, `export` and `report` on
 //! small real packings, including kill -9 in the middle of a job.
 
+mod common;
+
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-use serde_json::Value;
+use common::{fails, json, ok, path_in, sphere_campaign, write};
 use store::{ExportRow, JobState, Store};
-
-fn sedpack(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sedpack")).args(args).output().expect("sedpack runs")
-}
-
-fn ok(args: &[&str]) -> String {
-    let out = sedpack(args);
-    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
-    String::from_utf8(out.stdout).unwrap()
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> String {
-    let path = dir.join(name);
-    std::fs::write(&path, text).unwrap();
-    path.to_str().unwrap().to_string()
-}
 
 /// A 2 × 2 grid of sphere packings of ~60 grains; `shaking` sets how long each runs.
 fn campaign(name: &str, shaking: f64) -> String {
-    format!(
-        "name: {name}
-domain: {{kind: periodic, width: 0.03, height: 0.1}}
-grains:
-  shape: sphere
-  size: {{sieves: [0.0056, 0.008], fractions: [1.0]}}
-  mass: 0.03
-process:
-  generation: {{spacing: 0.009}}
-  shaking: {{duration: {shaking}}}
-evaluation: {{trim: 0.004}}
-grid:
-  material.friction: [0.0, 0.5]
-seeds: [1, 2]
-"
-    )
+    sphere_campaign(name, shaking, "grid:\n  material.friction: [0.0, 0.5]\nseeds: [1, 2]\n")
 }
 
 fn rows(db: &str, name: &str) -> Vec<ExportRow> {
@@ -61,11 +32,10 @@ fn porosities(db: &str, name: &str) -> Vec<(String, u64)> {
 fn a_grid_campaign_runs_once_and_reports() {
     let dir = tempfile::tempdir().unwrap();
     let file = write(dir.path(), "grid.yaml", &campaign("grid", 0.05));
-    let db = dir.path().join("sedpack.db");
-    let db = db.to_str().unwrap();
+    let db = &path_in(dir.path(), "sedpack.db");
     let first = ok(&["run", &file, "--db", db, "--workers", "2", "--quiet"]);
     assert!(first.contains("4 job(s), 4 new"), "{first}");
-    let status: Value = serde_json::from_str(&ok(&["status", "grid", "--db", db, "--json"])).unwrap();
+    let status = json(&["status", "grid", "--db", db, "--json"]);
     assert_eq!(
         (status["jobs"].as_u64(), status["done"].as_u64(), status["pending"].as_u64()),
         (Some(4), Some(4), Some(0))
@@ -112,47 +82,22 @@ fn a_saved_model_predicts_what_its_formula_gives() {
             "intercept": 0.28, "cv": {"folds": 10, "mae": 0.004, "r2": 0.97},
             "ranges": {"inv_mean_EQ": [1.5, 3.0], "inv_std_EL": [5.0, 10.0]}, "campaign": "c"}"#,
     );
-    let out = ok(&[
-        "predict",
-        "--model",
-        &model,
-        "--mu-fl",
-        "0.6",
-        "--sigma-fl",
-        "0.15",
-        "--mu-el",
-        "0.7",
-        "--sigma-el",
-        "0.1",
-        "--json",
-    ]);
-    let v: Value = serde_json::from_str(&out).unwrap();
+    let predict = |sigma_el: &str| {
+        let distribution = ["--mu-fl", "0.6", "--sigma-fl", "0.15", "--mu-el", "0.7", "--sigma-el", sigma_el];
+        json(&[&["predict", "--model", &model, "--json"][..], &distribution].concat())
+    };
+    let v = predict("0.1");
     // By hand: μ_EQ = 0.6 · 0.7 = 0.42, so n = 0.03/0.42 + 0.002/0.1 + 0.28.
     let expected = 0.03 / 0.42 + 0.002 / 0.1 + 0.28;
     assert!((v["porosity"].as_f64().unwrap() - expected).abs() < 1e-12);
     assert!(v["warnings"].as_array().unwrap().is_empty());
     // σ_EL = 0.05 puts inv_std_EL = 20 outside the training range [5, 10]: a warning.
-    let out = ok(&[
-        "predict",
-        "--model",
-        &model,
-        "--mu-fl",
-        "0.6",
-        "--sigma-fl",
-        "0.15",
-        "--mu-el",
-        "0.7",
-        "--sigma-el",
-        "0.05",
-        "--json",
-    ]);
-    let v: Value = serde_json::from_str(&out).unwrap();
+    let v = predict("0.05");
     assert!(v["warnings"][0].as_str().unwrap().contains("inv_std_EL"));
     // A CSV of measured grains gives every mixture feature: here two grains (FL, EL) of
     // (0.5, 0.8) and (0.7, 0.6), so EQ = 0.4 and 0.42, μ_EQ = 0.41; EL has σ = 0.1.
     let grains = write(dir.path(), "grains.csv", "FL,EL\n0.5,0.8\n0.7,0.6\n");
-    let out = ok(&["predict", "--model", &model, "--grains", &grains, "--json"]);
-    let v: Value = serde_json::from_str(&out).unwrap();
+    let v = json(&["predict", "--model", &model, "--grains", &grains, "--json"]);
     let expected = 0.03 / 0.41 + 0.002 / 0.1 + 0.28;
     assert!((v["porosity"].as_f64().unwrap() - expected).abs() < 1e-12, "{v}");
 }
@@ -161,8 +106,7 @@ fn a_saved_model_predicts_what_its_formula_gives() {
 fn ctrl_c_returns_running_jobs_to_pending() {
     let dir = tempfile::tempdir().unwrap();
     let file = write(dir.path(), "stop.yaml", &campaign("stop", 0.6));
-    let db = dir.path().join("stop.db");
-    let db = db.to_str().unwrap();
+    let db = &path_in(dir.path(), "stop.db");
     let child = Command::new(env!("CARGO_BIN_EXE_sedpack"))
         .args(["run", &file, "--db", db, "--workers", "1", "--quiet"])
         .stdout(Stdio::piped())
@@ -193,16 +137,14 @@ fn a_killed_runner_resumes_from_its_checkpoint_with_identical_results() {
     let dir = tempfile::tempdir().unwrap();
     let text = campaign("killed", 0.6);
     let file = write(dir.path(), "killed.yaml", &text);
-    let reference_db = dir.path().join("reference.db");
-    let reference_db = reference_db.to_str().unwrap();
+    let reference_db = &path_in(dir.path(), "reference.db");
     ok(&["run", &file, "--db", reference_db, "--workers", "2", "--quiet"]);
     let reference = porosities(reference_db, "killed");
     assert_eq!(reference.len(), 4);
 
     // One worker, a checkpoint every 0.2 s; killed once a job has finished and another has a
     // checkpoint.
-    let db = dir.path().join("killed.db");
-    let db = db.to_str().unwrap();
+    let db = &path_in(dir.path(), "killed.db");
     let mut child = Command::new(env!("CARGO_BIN_EXE_sedpack"))
         .args(["run", &file, "--db", db, "--workers", "1", "--quiet", "--checkpoint-interval", "0.2"])
         .stdout(Stdio::null())
@@ -251,8 +193,7 @@ fn a_killed_runner_resumes_from_its_checkpoint_with_identical_results() {
 fn two_runners_share_the_work_without_duplicates() {
     let dir = tempfile::tempdir().unwrap();
     let file = write(dir.path(), "shared.yaml", &campaign("shared", 0.05).replace("seeds: [1, 2]", "seeds: [1, 2, 3]"));
-    let db = dir.path().join("shared.db");
-    let db = db.to_str().unwrap();
+    let db = &path_in(dir.path(), "shared.db");
     let spawn = || {
         Command::new(env!("CARGO_BIN_EXE_sedpack"))
             .args(["run", &file, "--db", db, "--workers", "1", "--quiet"])
@@ -288,12 +229,11 @@ fn failing_jobs_are_recorded_and_retried_on_request() {
     let text = campaign("failing", 0.05)
         .replace("  material.friction: [0.0, 0.5]\nseeds: [1, 2]", "  solver.max_time: [30, 0.02]");
     let file = write(dir.path(), "failing.yaml", &text);
-    let db = dir.path().join("f.db");
-    let db = db.to_str().unwrap();
+    let db = &path_in(dir.path(), "f.db");
     let out = ok(&["run", &file, "--db", db, "--quiet"]);
     assert!(out.contains("1 job(s) finished now, 1 failed now"), "{out}");
     assert!(out.contains("not converged"), "the failure is shown with its error: {out}");
-    let status: Value = serde_json::from_str(&ok(&["status", "failing", "--db", db, "--json"])).unwrap();
+    let status = json(&["status", "failing", "--db", db, "--json"]);
     assert_eq!(status["failed"], 1);
     assert!(status["failures"][0]["error"].as_str().unwrap().contains("solver.max_time = 0.02"));
     let retried = ok(&["run", &file, "--db", db, "--retry-failed", "--quiet"]);
@@ -303,16 +243,7 @@ fn failing_jobs_are_recorded_and_retried_on_request() {
 #[test]
 fn bad_campaigns_and_databases_are_refused_clearly() {
     let dir = tempfile::tempdir().unwrap();
-    let fails = |args: &[&str], needles: &[&str]| {
-        let out = sedpack(args);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
-        for n in needles {
-            assert!(stderr.contains(n), "'{stderr}' lacks '{n}'");
-        }
-    };
-    let db = dir.path().join("x.db");
-    let db = db.to_str().unwrap();
+    let db = &path_in(dir.path(), "x.db");
     let empty = write(dir.path(), "empty.yaml", "name: e\ngrid:\n  material.friction: []\n");
     fails(&["run", &empty, "--db", db], &["empty.yaml:3", "grid.material.friction", "empty list"]);
     let typo = write(dir.path(), "typo.yaml", "name: t\ngrains:\n  shape: sphere\n  mas: 0.1\n");

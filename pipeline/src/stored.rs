@@ -1,0 +1,354 @@
+//! The stored job: the JSON a job keeps in the database and whose hash is its id. Its format
+//! is written out here type by type, apart from the solver's types, so that changing those
+//! never changes a stored job or an id; every value is concrete (the paper's rules already
+//! applied), so a job runs the same whatever later versions take as defaults.
+//!
+//! Format 1 is the JSON of sedpack 0.1.0, byte for byte. A new format gets a new number (the
+//! `format` column of the jobs table) and its own types beside these.
+
+use anyhow::{Context, bail};
+use nalgebra::Vector3;
+use solver::dem::{Calibration, Domain, Material, Shaking};
+use solver::grain::{FormDistribution, MeshLibrary, SieveCurve, Table3Case};
+use solver::packing::{FormSpec, GrainSpec, PackingSpec, Process, ShapeKind};
+
+use crate::spec::JobSpec;
+
+/// The format this version writes.
+pub const FORMAT: u32 = 1;
+
+/// Format 1, the JSON of sedpack 0.1.0.
+mod v1 {
+    use serde::{Deserialize, Serialize};
+
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    pub(super) struct Job {
+        pub(super) name: String,
+        /// The Table 3 case of the sieve curve, or "custom".
+        pub(super) size_case: String,
+        pub(super) packing: Packing,
+        pub(super) experiment: Option<Experiment>,
+    }
+
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    pub(super) struct Packing {
+        pub(super) domain: Domain,
+        pub(super) height: f64,
+        pub(super) grains: Grains,
+        pub(super) material: Material,
+        pub(super) time_step: f64,
+        pub(super) calibration: Calibration,
+        pub(super) process: Process,
+        pub(super) slice: f64,
+        pub(super) cutoff: f64,
+        pub(super) trim: Option<f64>,
+        pub(super) seed: u64,
+    }
+
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    pub(super) enum Domain {
+        Periodic { width: f64 },
+        Cylinder { diameter: f64 },
+    }
+
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    pub(super) struct Grains {
+        pub(super) shape: Shape,
+        pub(super) size: Size,
+        pub(super) mass: f64,
+        pub(super) form: Form,
+        pub(super) meshes: Option<Meshes>,
+    }
+
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    pub(super) enum Shape {
+        Sphere,
+        Ellipsoid,
+        BondedSpheres,
+        Mesh,
+    }
+
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    pub(super) struct Size {
+        pub(super) sieves: Vec<f64>,
+        pub(super) fractions: Vec<f64>,
+    }
+
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    pub(super) enum Form {
+        Single { fl: f64, el: f64 },
+        Distribution(Distribution),
+        Own,
+    }
+
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    pub(super) struct Distribution {
+        pub(super) mu_fl: f64,
+        pub(super) sigma_fl: f64,
+        pub(super) mu_el: f64,
+        pub(super) sigma_el: f64,
+    }
+
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    pub(super) struct Meshes {
+        pub(super) source: String,
+        pub(super) faces: usize,
+        pub(super) digest: String,
+    }
+
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    pub(super) struct Material {
+        pub(super) density: f64,
+        pub(super) fluid_density: f64,
+        /// g: gravity is (0, 0, −g).
+        pub(super) gravity: f64,
+        pub(super) restitution: f64,
+        pub(super) collision_time: f64,
+        pub(super) poisson_ratio: f64,
+        pub(super) friction: f64,
+    }
+
+    /// The discrete calibration repeats the time step, which must equal `time_step`.
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    pub(super) enum Calibration {
+        Continuous,
+        Discrete { time_step: f64 },
+    }
+
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    pub(super) struct Process {
+        pub(super) spacing: f64,
+        pub(super) velocity: f64,
+        pub(super) shaking: Shaking,
+        pub(super) shaking_duration: f64,
+        pub(super) damping: f64,
+        pub(super) height_change: f64,
+        pub(super) interval: f64,
+        pub(super) max_time: f64,
+    }
+
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    pub(super) struct Shaking {
+        pub(super) amplitude: f64,
+        pub(super) period: f64,
+    }
+
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    pub(super) struct Experiment {
+        pub(super) porosity: f64,
+        pub(super) std: Option<f64>,
+    }
+}
+
+/// The stored JSON of a job, in format [`FORMAT`].
+pub fn encode(job: &JobSpec) -> serde_json::Value {
+    serde_json::to_value(stored(job)).expect("the stored job is plain numbers, strings and lists")
+}
+
+/// The stored JSON as text: the input of the job id.
+pub fn canonical_json(job: &JobSpec) -> String {
+    serde_json::to_string(&stored(job)).expect("the stored job is plain numbers, strings and lists")
+}
+
+/// The job a stored JSON of the given format describes. Its meshes, if any, are only named: the
+/// caller loads them again.
+pub fn decode(format: u32, json: &serde_json::Value) -> anyhow::Result<JobSpec> {
+    if format != FORMAT {
+        bail!("the job is stored in format {format}, which this version of sedpack (format {FORMAT}) cannot read");
+    }
+    let job: v1::Job = serde_json::from_value(json.clone()).context("the stored job is not format 1")?;
+    let p = job.packing;
+    let time_step = p.time_step;
+    let calibration = match p.calibration {
+        v1::Calibration::Continuous => Calibration::Continuous,
+        v1::Calibration::Discrete { time_step: t } if t == time_step => Calibration::Discrete,
+        v1::Calibration::Discrete { time_step: t } => {
+            bail!("the stored job calibrates its contacts for a time step of {t} s but steps with {time_step} s")
+        }
+    };
+    let size = match job.size_case.as_str() {
+        "custom" => SieveCurve::new(p.grains.size.sieves, p.grains.size.fractions)?,
+        name => {
+            let curve = Table3Case::find(name).with_context(|| format!("unknown size case {name:?}"))?.sieve_curve();
+            if (curve.sieves(), curve.fractions()) != (&p.grains.size.sieves[..], &p.grains.size.fractions[..]) {
+                bail!("the stored sieve curve is not that of size case {name}");
+            }
+            curve
+        }
+    };
+    let packing = PackingSpec {
+        domain: match p.domain {
+            v1::Domain::Periodic { width } => Domain::Periodic { width },
+            v1::Domain::Cylinder { diameter } => Domain::Cylinder { diameter },
+        },
+        height: Some(p.height),
+        grains: GrainSpec {
+            shape: match p.grains.shape {
+                v1::Shape::Sphere => ShapeKind::Sphere,
+                v1::Shape::Ellipsoid => ShapeKind::Ellipsoid,
+                v1::Shape::BondedSpheres => ShapeKind::BondedSpheres,
+                v1::Shape::Mesh => ShapeKind::Mesh,
+            },
+            size,
+            mass: p.grains.mass,
+            form: match p.grains.form {
+                v1::Form::Single { fl, el } => FormSpec::Single { fl, el },
+                v1::Form::Distribution(d) => FormSpec::Distribution(FormDistribution {
+                    mu_fl: d.mu_fl,
+                    sigma_fl: d.sigma_fl,
+                    mu_el: d.mu_el,
+                    sigma_el: d.sigma_el,
+                }),
+                v1::Form::Own => FormSpec::Own,
+            },
+            meshes: p.grains.meshes.map(|m| MeshLibrary {
+                source: m.source,
+                faces: m.faces,
+                digest: m.digest,
+                meshes: Vec::new(),
+            }),
+        },
+        material: Material {
+            density: p.material.density,
+            fluid_density: p.material.fluid_density,
+            gravity: Vector3::new(0.0, 0.0, -p.material.gravity),
+            restitution: p.material.restitution,
+            collision_time: p.material.collision_time,
+            poisson_ratio: p.material.poisson_ratio,
+            friction: p.material.friction,
+        },
+        time_step,
+        calibration,
+        process: Process {
+            spacing: Some(p.process.spacing),
+            velocity: p.process.velocity,
+            shaking: Shaking { amplitude: p.process.shaking.amplitude, period: p.process.shaking.period },
+            shaking_duration: p.process.shaking_duration,
+            damping: p.process.damping,
+            height_change: p.process.height_change,
+            interval: p.process.interval,
+            max_time: Some(p.process.max_time),
+        },
+        slice: p.slice,
+        cutoff: p.cutoff,
+        trim: p.trim,
+        seed: p.seed,
+    };
+    packing.check().context("the stored job")?;
+    let experiment = job.experiment.map(|e| analysis::Experiment { porosity: e.porosity, std: e.std });
+    Ok(JobSpec { name: job.name, packing, experiment })
+}
+
+fn stored(job: &JobSpec) -> v1::Job {
+    let spec = &job.packing;
+    let derived = spec.derived();
+    let grains = &spec.grains;
+    let m = &spec.material;
+    let p = &spec.process;
+    v1::Job {
+        name: job.name.clone(),
+        size_case: grains.size.case().map_or("custom", |c| c.name).to_string(),
+        packing: v1::Packing {
+            domain: match spec.domain {
+                Domain::Periodic { width } => v1::Domain::Periodic { width },
+                Domain::Cylinder { diameter } => v1::Domain::Cylinder { diameter },
+            },
+            height: derived.height,
+            grains: v1::Grains {
+                shape: match grains.shape {
+                    ShapeKind::Sphere => v1::Shape::Sphere,
+                    ShapeKind::Ellipsoid => v1::Shape::Ellipsoid,
+                    ShapeKind::BondedSpheres => v1::Shape::BondedSpheres,
+                    ShapeKind::Mesh => v1::Shape::Mesh,
+                },
+                size: v1::Size { sieves: grains.size.sieves().to_vec(), fractions: grains.size.fractions().to_vec() },
+                mass: grains.mass,
+                form: match grains.form {
+                    FormSpec::Single { fl, el } => v1::Form::Single { fl, el },
+                    FormSpec::Distribution(d) => v1::Form::Distribution(v1::Distribution {
+                        mu_fl: d.mu_fl,
+                        sigma_fl: d.sigma_fl,
+                        mu_el: d.mu_el,
+                        sigma_el: d.sigma_el,
+                    }),
+                    FormSpec::Own => v1::Form::Own,
+                },
+                meshes: grains.meshes.as_ref().map(|l| v1::Meshes {
+                    source: l.source.clone(),
+                    faces: l.faces,
+                    digest: l.digest.clone(),
+                }),
+            },
+            material: v1::Material {
+                density: m.density,
+                fluid_density: m.fluid_density,
+                gravity: -m.gravity.z,
+                restitution: m.restitution,
+                collision_time: m.collision_time,
+                poisson_ratio: m.poisson_ratio,
+                friction: m.friction,
+            },
+            time_step: spec.time_step,
+            calibration: match spec.calibration {
+                Calibration::Continuous => v1::Calibration::Continuous,
+                Calibration::Discrete => v1::Calibration::Discrete { time_step: spec.time_step },
+            },
+            process: v1::Process {
+                spacing: derived.spacing,
+                velocity: p.velocity,
+                shaking: v1::Shaking { amplitude: p.shaking.amplitude, period: p.shaking.period },
+                shaking_duration: p.shaking_duration,
+                damping: p.damping,
+                height_change: p.height_change,
+                interval: p.interval,
+                max_time: derived.max_time,
+            },
+            slice: spec.slice,
+            cutoff: spec.cutoff,
+            trim: spec.trim,
+            seed: spec.seed,
+        },
+        experiment: job.experiment.map(|e| v1::Experiment { porosity: e.porosity, std: e.std }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use solver::packing::DomainKind;
+
+    use super::*;
+
+    fn job(packing: PackingSpec) -> JobSpec {
+        JobSpec { name: "j".into(), packing, experiment: Some(analysis::Experiment { porosity: 0.37, std: None }) }
+    }
+
+    #[test]
+    fn a_stored_job_reads_back_as_the_job_with_its_rules_applied() {
+        let mut cylinder = PackingSpec::paper(DomainKind::Cylinder);
+        cylinder.calibration = Calibration::Continuous;
+        cylinder.trim = Some(0.002);
+        for spec in [PackingSpec::paper(DomainKind::Periodic), cylinder] {
+            let original = job(spec);
+            let back = decode(FORMAT, &encode(&original)).unwrap();
+            assert_eq!(back.packing.derived(), original.packing.derived());
+            assert_eq!(back.packing.height, Some(original.packing.derived().height));
+            assert_eq!((back.name.as_str(), back.experiment), ("j", original.experiment));
+            assert_eq!(canonical_json(&back), canonical_json(&original));
+        }
+    }
+
+    #[test]
+    fn stored_jobs_that_disagree_with_themselves_or_another_format_are_refused() {
+        let stored = encode(&job(PackingSpec::paper(DomainKind::Periodic)));
+        let error = decode(2, &stored).unwrap_err().to_string();
+        assert!(error.contains("format 2"), "{error}");
+        let mut two_steps = stored.clone();
+        two_steps["packing"]["calibration"]["Discrete"]["time_step"] = serde_json::json!(1e-5);
+        let error = decode(FORMAT, &two_steps).unwrap_err().to_string();
+        assert!(error.contains("1e-5") || error.contains("0.00001"), "{error}");
+        let mut renamed = stored;
+        renamed["size_case"] = serde_json::json!("U7");
+        let error = decode(FORMAT, &renamed).unwrap_err().to_string();
+        assert!(error.contains("size case U7"), "{error}");
+    }
+}

@@ -1,0 +1,32 @@
+//! Job ids are hashes of the stored job: the same campaign file must give the same ids and the
+//! same stored JSON as sedpack 0.1.0 gave (tests/fixtures/job-ids/ids-0.1.0.json), or resubmitted
+//! campaigns would run every job again.
+
+mod common;
+
+use common::{fixture, repo};
+use serde_json::Value;
+
+#[test]
+fn campaign_files_give_the_job_ids_of_version_0_1_0() {
+    let golden: serde_json::Map<String, Value> =
+        serde_json::from_str(&std::fs::read_to_string(fixture("job-ids/ids-0.1.0.json")).unwrap()).unwrap();
+    assert_eq!(golden.len(), 11);
+    for (file, jobs) in &golden {
+        let path = match file.split_once('/') {
+            Some(("campaigns", _)) => repo(file).into(),
+            Some(_) => fixture(file),
+            None => fixture(&format!("job-ids/{file}")),
+        };
+        let campaign = sedpack::campaign::read_campaign(&path).unwrap_or_else(|e| panic!("{file}: {e:#}"));
+        let jobs = jobs.as_array().unwrap();
+        assert_eq!(campaign.jobs.len(), jobs.len(), "{file}");
+        for (job, want) in campaign.jobs.iter().zip(jobs) {
+            if let Some(spec) = want.get("spec") {
+                let stored: Value = serde_json::from_str(&sedpack::stored::canonical_json(&job.spec)).unwrap();
+                assert_eq!(&stored, spec, "{file}: the stored job");
+            }
+            assert_eq!(job.id, want["id"].as_str().unwrap(), "{file}");
+        }
+    }
+}
