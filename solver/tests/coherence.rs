@@ -5,33 +5,20 @@
 //! confirmed from the last step's features, and the closed-form and clipped-cell centres of
 //! pressure; the full query is the cold GJK + EPA with the overlap clipped facet by facet.
 
-use solver::dem::{Audit, Calibration, Domain, Shaking};
-use solver::grain::{FormDistribution, MeshLibrary, SieveCurve, UnitMesh, rhine_meshes};
-use solver::packing::{FormSpec, GrainSpec, Material, Packing, PackingSpec, Phase, Process, ShapeKind};
+mod common;
+
+use common::small_bed;
+use solver::dem::Audit;
+use solver::grain::{MeshLibrary, RHINE_FORMS, UnitMesh, rhine_meshes};
+use solver::packing::{FormSpec, Packing, PackingSpec, Phase, ShapeKind};
 
 fn spec(shape: ShapeKind, form: FormSpec, meshes: Option<MeshLibrary>, mass: f64) -> PackingSpec {
-    PackingSpec {
-        domain: Domain::Periodic { width: 0.04 },
-        height: 0.15,
-        grains: GrainSpec { shape, size: SieveCurve::new(vec![5.6e-3, 8e-3], vec![1.0]).unwrap(), mass, form, meshes },
-        material: Material::default(),
-        time_step: 5e-6,
-        calibration: Calibration::Discrete { time_step: 5e-6 },
-        process: Process {
-            spacing: 0.012,
-            velocity: 1.0,
-            shaking: Shaking { amplitude: 3e-4, period: 0.025 },
-            shaking_duration: 0.05,
-            damping: 1e-3,
-            height_change: 1e-5,
-            interval: 0.01,
-            max_time: 5.0,
-        },
-        slice: 1e-3,
-        cutoff: 0.5,
-        trim: Some(4e-3),
-        seed: 3,
-    }
+    let mut spec = small_bed(shape, mass, 0.012, 0.05);
+    spec.grains.form = form;
+    spec.grains.meshes = meshes;
+    spec.trim = Some(4e-3);
+    spec.seed = 3;
+    spec
 }
 
 /// Audits every other step until the packing converges; the audit of each phase.
@@ -77,8 +64,7 @@ fn polyhedron_shortcuts_agree_with_the_full_query_through_a_packing() {
 
 #[test]
 fn ellipsoid_pairs_skipped_as_apart_never_touch() {
-    let rhine = FormDistribution { mu_fl: 0.647, sigma_fl: 0.175, mu_el: 0.682, sigma_el: 0.139 };
-    let audits = audited(spec(ShapeKind::Ellipsoid, FormSpec::Distribution(rhine), None, 0.04));
+    let audits = audited(spec(ShapeKind::Ellipsoid, FormSpec::Distribution(RHINE_FORMS), None, 0.04));
     let contacts: usize = audits.iter().map(|(_, a)| a.contacts).sum();
     assert!(contacts > 100_000, "{contacts} contacts");
     for (phase, a) in &audits {
