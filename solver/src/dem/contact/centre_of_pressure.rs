@@ -415,6 +415,9 @@ struct Cell {
     /// Per vertex during a cut: its plane value, and the vertex it becomes after compaction.
     value: [f64; CELL_VERTICES],
     renumber: [u8; CELL_VERTICES],
+    /// The kept vertices in their new order during compaction (here, so that no cut zeroes a
+    /// buffer of its own).
+    moved: [V3; CELL_VERTICES],
     /// The crossings made by the current cut: edge (in, out) → new vertex.
     crossings: [(u8, u8, u8); CELL_FACES],
     n_crossings: usize,
@@ -431,6 +434,7 @@ thread_local! {
         radius: 0.0,
         value: [0.0; CELL_VERTICES],
         renumber: [0; CELL_VERTICES],
+        moved: [V3::zeros(); CELL_VERTICES],
         crossings: [(0, 0, 0); CELL_FACES],
         n_crossings: 0,
     }));
@@ -629,14 +633,13 @@ impl Cell {
                 *c = self.renumber[*c as usize];
             }
         }
-        let mut moved = [V3::zeros(); CELL_VERTICES];
         for k in 0..self.n_vertices {
             let r = self.renumber[k];
             if r != u8::MAX {
-                moved[r as usize] = self.vertices[k];
+                self.moved[r as usize] = self.vertices[k];
             }
         }
-        self.vertices[..next].copy_from_slice(&moved[..next]);
+        self.vertices[..next].copy_from_slice(&self.moved[..next]);
         self.n_vertices = next;
         self.bound();
     }
