@@ -8,7 +8,6 @@ use std::path::Path;
 use anyhow::anyhow;
 use serde_json::{Map, Value as Json};
 use serde_norway::{Mapping, Value};
-use sha2::{Digest, Sha256};
 
 use crate::job_file::{Source, parse_job_value, read_yaml};
 use crate::spec::{JobSpec, resolve};
@@ -28,13 +27,6 @@ pub struct PlannedJob {
     pub spec: JobSpec,
     /// The grid values of this job (dotted key → value) and its seed.
     pub parameters: Map<String, Json>,
-}
-
-/// Stable id of a resolved job: the first 16 hex digits of the SHA-256 of its stored JSON
-/// (which includes the campaign name, so ids never collide across campaigns).
-pub fn job_id(spec: &JobSpec) -> String {
-    let digest = Sha256::digest(stored::canonical_json(spec).as_bytes());
-    digest.iter().take(8).map(|b| format!("{b:02x}")).collect()
 }
 
 pub fn read_campaign(path: &Path) -> anyhow::Result<Campaign> {
@@ -84,7 +76,7 @@ pub fn read_campaign(path: &Path) -> anyhow::Result<Campaign> {
             let spec = resolve(file, &source)
                 .map_err(|e| if point.is_empty() { e } else { e.context(format!("grid point {}", describe())) })?;
             parameters.insert("seed".into(), Json::from(spec.packing.seed));
-            let id = job_id(&spec);
+            let id = stored::job_id(&spec);
             if let Some(twin) = jobs.iter().find(|j| j.id == id) {
                 return Err(anyhow!(
                     "{}: grid points {:?} and {:?} give the same job: a grid key has no effect",
