@@ -1,5 +1,6 @@
 //! Campaign files: a job template plus `grid:` (dotted key → list of values, expanded as a
-//! cartesian product) and `seeds:` (each grid point runs once per seed). Every job is resolved
+//! cartesian product), `seeds:` (each grid point runs once per seed) and an optional `executor:`
+//! block (where the jobs run, which is not part of any job). Every job is resolved
 //! in full and identified by a hash of its resolved spec, so that submitting a campaign twice
 //! adds nothing and adding grid values adds only the new jobs.
 
@@ -9,6 +10,7 @@ use anyhow::anyhow;
 use serde_json::{Map, Value as Json};
 use serde_norway::{Mapping, Value};
 
+use crate::executor::{ExecutorFile, Request};
 use crate::job_file::{Source, parse_job_value, read_yaml};
 use crate::spec::{JobSpec, resolve};
 use crate::stored;
@@ -19,6 +21,8 @@ pub struct Campaign {
     /// The campaign file as submitted.
     pub text: String,
     pub jobs: Vec<PlannedJob>,
+    /// What the `executor:` block asks for (nothing without one).
+    pub executor: Request,
 }
 
 #[derive(Debug, Clone)]
@@ -34,6 +38,19 @@ pub fn read_campaign(path: &Path) -> anyhow::Result<Campaign> {
     let source = Source { path, text: &text };
     let Value::Mapping(mut template) = value else {
         return Err(anyhow!("{}: a campaign file must be a mapping of keys", path.display()));
+    };
+    let executor = match template.remove("executor") {
+        None => Request::default(),
+        Some(block) => {
+            let file: ExecutorFile = serde_path_to_error::deserialize(block).map_err(|e| {
+                let key = match e.path().to_string().as_str() {
+                    "." => "executor".to_string(),
+                    path => format!("executor.{path}"),
+                };
+                source.error(&key, e.into_inner())
+            })?;
+            file.request().map_err(|(key, message)| source.error(key, message))?
+        }
     };
     let grid = match template.remove("grid") {
         None => Vec::new(),
@@ -89,7 +106,7 @@ pub fn read_campaign(path: &Path) -> anyhow::Result<Campaign> {
         }
     }
     let name = jobs[0].spec.name.clone();
-    Ok(Campaign { name, text, jobs })
+    Ok(Campaign { name, text, jobs, executor })
 }
 
 /// The grid as (dotted key, values) in file order; every list must be non-empty.

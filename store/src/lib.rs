@@ -180,20 +180,24 @@ impl Store {
         }))
     }
 
-    /// Hands up to `count` of the campaign's pending jobs, in submission order, to the workers
-    /// `worker(k)` (k = 0, 1, … in the order handed) in one transaction, and gives them.
+    /// Hands up to `count` of the campaign's pending jobs (of those in `only`, if given), in
+    /// submission order, to the workers `worker(k)` (k = 0, 1, … in the order handed) in one
+    /// transaction, and gives them.
     pub async fn claim_many(
         &self,
         campaign: &str,
+        only: Option<&[String]>,
         count: usize,
         worker: impl Fn(usize) -> String,
     ) -> Result<Vec<ClaimedJob>, StoreError> {
+        let only = only.map(|ids| self.encode_json(&ids, "job ids")).transpose()?;
         let mut tx = self.pool.begin_with(sql::BEGIN_IMMEDIATE).await.map_err(self.db())?;
         let campaign_id = self.campaign_id(&mut tx, campaign).await?;
         let limit = i64::try_from(count).unwrap_or(i64::MAX);
         let ids: Vec<String> = sqlx::query_scalar(sql::PENDING_JOBS)
             .bind(campaign_id)
             .bind(limit)
+            .bind(only)
             .fetch_all(&mut *tx)
             .await
             .map_err(self.db())?;

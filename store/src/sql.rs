@@ -41,7 +41,9 @@ pub const CLAIM_JOBS: &str = "
     WHERE id = ?1 AND campaign_id = ?2 AND state = 'pending'
     RETURNING id, format, spec, seed, parameters, attempts";
 pub const PENDING_JOBS: &str = "
-    SELECT id FROM jobs WHERE campaign_id = ?1 AND state = 'pending' ORDER BY rowid LIMIT ?2";
+    SELECT id FROM jobs
+    WHERE campaign_id = ?1 AND state = 'pending' AND (?3 IS NULL OR id IN (SELECT value FROM json_each(?3)))
+    ORDER BY rowid LIMIT ?2";
 pub const REASSIGN_JOB: &str = "
     UPDATE jobs SET worker_id = ?3, heartbeat_at = ?4
     WHERE id = ?1 AND worker_id = ?2 AND state = 'running'";

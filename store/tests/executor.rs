@@ -30,19 +30,24 @@ async fn many_jobs_are_claimed_at_once_each_by_its_own_worker() {
     let dir = tempfile::tempdir().unwrap();
     let store = store_with_jobs(&db_path(&dir), 5).await;
     let first = store.claim(CAMPAIGN, "local").await.unwrap().unwrap();
-    let claimed = store.claim_many(CAMPAIGN, 3, |k| format!("array_{k}")).await.unwrap();
+    // Only the jobs asked for, if they are pending.
+    let only = ["job-0000".to_string(), "job-0002".to_string()];
+    let picked = store.claim_many(CAMPAIGN, Some(&only), 5, |k| format!("only_{k}")).await.unwrap();
+    assert_eq!(picked.iter().map(|c| c.id.as_str()).collect::<Vec<_>>(), ["job-0002"]);
+    store.release("job-0002", "only_0").await.unwrap();
+    let claimed = store.claim_many(CAMPAIGN, None, 3, |k| format!("array_{k}")).await.unwrap();
     let ids: Vec<&str> = claimed.iter().map(|c| c.id.as_str()).collect();
     assert_eq!(ids, ["job-0001", "job-0002", "job-0003"], "in submission order, the claimed one skipped");
-    assert!(claimed.iter().all(|c| c.attempts == 1));
+    assert_eq!(claimed.iter().map(|c| c.attempts).collect::<Vec<_>>(), [1, 2, 1], "job-0002 was claimed before");
     let running = store.running_jobs(CAMPAIGN).await.unwrap();
     let workers: Vec<(&str, &str)> = running.iter().map(|r| (r.job_id.as_str(), r.worker_id.as_str())).collect();
     assert_eq!(
         workers,
         [("job-0000", "local"), ("job-0001", "array_0"), ("job-0002", "array_1"), ("job-0003", "array_2")]
     );
-    let rest = store.claim_many(CAMPAIGN, 10, |k| format!("b_{k}")).await.unwrap();
+    let rest = store.claim_many(CAMPAIGN, None, 10, |k| format!("b_{k}")).await.unwrap();
     assert_eq!(rest.iter().map(|c| c.id.as_str()).collect::<Vec<_>>(), ["job-0004"]);
-    assert!(store.claim_many(CAMPAIGN, 10, |k| format!("c_{k}")).await.unwrap().is_empty());
+    assert!(store.claim_many(CAMPAIGN, None, 10, |k| format!("c_{k}")).await.unwrap().is_empty());
     assert_ne!(first.id, rest[0].id);
     store.close().await;
 }
@@ -51,7 +56,7 @@ async fn many_jobs_are_claimed_at_once_each_by_its_own_worker() {
 async fn a_running_job_is_handed_over_only_by_its_worker() {
     let dir = tempfile::tempdir().unwrap();
     let store = store_with_jobs(&db_path(&dir), 1).await;
-    let job = &store.claim_many(CAMPAIGN, 1, |_| "submitting:1".into()).await.unwrap()[0];
+    let job = &store.claim_many(CAMPAIGN, None, 1, |_| "submitting:1".into()).await.unwrap()[0];
     assert!(!store.reassign(&job.id, "someone", "slurm:7_0").await.unwrap());
     assert!(store.reassign(&job.id, "submitting:1", "slurm:7_0").await.unwrap());
     assert!(!store.reassign(&job.id, "submitting:1", "slurm:8_0").await.unwrap(), "handed over once");
