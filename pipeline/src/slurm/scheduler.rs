@@ -136,8 +136,25 @@ pub fn states(tasks: &[String]) -> anyhow::Result<HashMap<String, TaskState>> {
     if tasks.iter().any(|t| !known.contains_key(t))
         && let Some(accounted) = sacct(&arrays)?
     {
+        // An array cancelled before any task started has one record, under the array's id.
+        let mut whole: HashMap<String, TaskState> = HashMap::new();
         for t in accounted {
-            known.entry(t.task.clone()).or_insert(t);
+            match t.task.split_once('_') {
+                Some((_, index)) if !index.starts_with('[') => {
+                    known.entry(t.task.clone()).or_insert(t);
+                }
+                _ => {
+                    let array = t.task.split('_').next().unwrap_or_default().to_string();
+                    whole.insert(array, t);
+                }
+            }
+        }
+        for task in tasks {
+            if let (false, Some(array)) = (known.contains_key(task), task.split_once('_').map(|(a, _)| a))
+                && let Some(t) = whole.get(array)
+            {
+                known.insert(task.clone(), TaskState { task: task.clone(), ..t.clone() });
+            }
         }
     }
     Ok(known)
