@@ -10,7 +10,7 @@ use anyhow::anyhow;
 use serde_json::{Map, Value as Json};
 use serde_norway::{Mapping, Value};
 
-use crate::executor::{ExecutorFile, Request};
+use crate::executor::Request;
 use crate::job_file::{Source, parse_job_value, read_yaml};
 use crate::spec::{JobSpec, resolve};
 use crate::stored;
@@ -42,14 +42,14 @@ pub fn read_campaign(path: &Path) -> anyhow::Result<Campaign> {
     let executor = match template.remove("executor") {
         None => Request::default(),
         Some(block) => {
-            let file: ExecutorFile = serde_path_to_error::deserialize(block).map_err(|e| {
+            let request: Request = serde_path_to_error::deserialize(block).map_err(|e| {
                 let key = match e.path().to_string().as_str() {
                     "." => "executor".to_string(),
                     path => format!("executor.{path}"),
                 };
                 source.error(&key, e.into_inner())
             })?;
-            file.request().map_err(|(key, message)| source.error(key, message))?
+            request.checked_block().map_err(|(key, message)| source.error(key, message))?
         }
     };
     let grid = match template.remove("grid") {

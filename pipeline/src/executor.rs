@@ -89,7 +89,17 @@ impl Serialize for TimeLimit {
 
 impl<'de> Deserialize<'de> for TimeLimit {
     fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        TimeLimit::parse(&String::deserialize(deserializer)?).map_err(serde::de::Error::custom)
+        struct Clock;
+        impl serde::de::Visitor<'_> for Clock {
+            type Value = TimeLimit;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a time limit HH:MM:SS or D-HH:MM:SS")
+            }
+            fn visit_str<E: serde::de::Error>(self, text: &str) -> Result<TimeLimit, E> {
+                TimeLimit::parse(text).map_err(E::custom)
+            }
+        }
+        deserializer.deserialize_str(Clock)
     }
 }
 
@@ -103,7 +113,8 @@ pub enum Kind {
 /// Executor keys as given in a campaign file's `executor:` block or on the command line; None
 /// where not given. The names are the command line's (`--cpus-per-task`) and the file's
 /// (`cpus_per_task`).
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Request {
     pub kind: Option<Kind>,
     pub sbatch: Option<String>,
@@ -112,34 +123,14 @@ pub struct Request {
     pub max_parallel: Option<usize>,
 }
 
-/// The `executor:` block of a campaign file, as written.
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ExecutorFile {
-    pub kind: Option<Kind>,
-    pub sbatch: Option<String>,
-    pub cpus_per_task: Option<usize>,
-    pub time: Option<String>,
-    pub max_parallel: Option<usize>,
-}
-
-impl ExecutorFile {
-    /// The request the block makes; an error names the key (under `executor.`) and what it expects.
-    pub fn request(self) -> Result<Request, (&'static str, String)> {
-        let time = self.time.map(|t| TimeLimit::parse(&t).map_err(|e| ("executor.time", e.to_string()))).transpose()?;
-        let request = Request {
-            kind: self.kind,
-            sbatch: self.sbatch,
-            cpus_per_task: self.cpus_per_task,
-            time,
-            max_parallel: self.max_parallel,
-        };
-        request.check("executor.")?;
-        Ok(request)
-    }
-}
-
 impl Request {
+    /// The request of a campaign file's `executor:` block; an error names the key (under
+    /// `executor.`) and what it expects.
+    pub fn checked_block(self) -> Result<Request, (&'static str, String)> {
+        self.check("executor.")?;
+        Ok(self)
+    }
+
     /// This request where it says something, `base` elsewhere.
     pub fn over(self, base: Request) -> Request {
         Request {
@@ -304,10 +295,10 @@ mod tests {
     fn slurm_keys_with_the_local_executor_or_zero_counts_are_refused() {
         let local = Request { kind: Some(Kind::Local), time: Some(TimeLimit(60)), ..Request::default() };
         assert_eq!(local.checked_flags().unwrap_err().to_string(), "--time: applies to the slurm executor only");
-        let file = ExecutorFile { kind: Some(Kind::Local), max_parallel: Some(2), ..ExecutorFile::default() };
-        assert_eq!(file.request().unwrap_err().0, "executor.max_parallel");
-        let zero = ExecutorFile { cpus_per_task: Some(0), ..ExecutorFile::default() };
-        assert_eq!(zero.request().unwrap_err(), ("executor.cpus_per_task", "expected at least 1, got 0".into()));
+        let block = Request { kind: Some(Kind::Local), max_parallel: Some(2), ..Request::default() };
+        assert_eq!(block.checked_block().unwrap_err().0, "executor.max_parallel");
+        let zero = Request { cpus_per_task: Some(0), ..Request::default() };
+        assert_eq!(zero.checked_block().unwrap_err(), ("executor.cpus_per_task", "expected at least 1, got 0".into()));
         let quotes = Request { sbatch: Some("--comment='x".into()), ..Request::default() };
         assert!(quotes.checked_flags().unwrap_err().to_string().starts_with("--sbatch: unbalanced quotes"));
     }

@@ -99,11 +99,7 @@ fn local_reference(file: &str, dir: &Path) -> BTreeMap<String, u64> {
 /// The events the tasks of a job recorded in its folder, as JSON values.
 fn events(db: &str, campaign: &str, job: &str) -> Vec<Value> {
     let file = Path::new(db).with_extension("runs").join(campaign).join(job).join("events");
-    std::fs::read_to_string(&file)
-        .unwrap_or_default()
-        .lines()
-        .filter_map(|l| serde_json::from_str(l).ok())
-        .collect()
+    std::fs::read_to_string(&file).unwrap_or_default().lines().filter_map(|l| serde_json::from_str(l).ok()).collect()
 }
 
 fn count(events: &[Value], kind: &str) -> usize {
@@ -124,7 +120,9 @@ fn fresh_task(db: &str, name: &str, jobs: &[String]) -> (String, String) {
             if t["slurm_state"] != "RUNNING" || !jobs.iter().any(|j| j == job) {
                 return None;
             }
-            let started = events(db, name, job).iter().rev().find(|e| e["task"] == task && e["kind"] == "started")?["at"].as_f64()?;
+            let started =
+                events(db, name, job).iter().rev().find(|e| e["task"] == task && e["kind"] == "started")?["at"]
+                    .as_f64()?;
             let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap().as_secs_f64();
             (now - started < 1.0).then(|| (task.to_string(), job.to_string()))
         })
@@ -213,8 +211,12 @@ fn killed_submitters_scancel_requeue_and_preemption_lose_nothing_and_run_nothing
     // 1. Killed after sbatch took the array and before its tasks were recorded: the next
     // command finds them by the array's comment.
     let mark = dir.path().join("submitted");
-    let slow = fake_sbatch(dir.path(), &format!("out=$(\"$REAL\" \"$@\") || exit\necho \"$out\"\ntouch {}\nsleep 3", mark.display()));
-    let submitter = spawn(&["run", &file, "--db", db, "--executor", "slurm", "--max-parallel", "2", "--quiet"], Some(&slow));
+    let slow = fake_sbatch(
+        dir.path(),
+        &format!("out=$(\"$REAL\" \"$@\") || exit\necho \"$out\"\ntouch {}\nsleep 3", mark.display()),
+    );
+    let submitter =
+        spawn(&["run", &file, "--db", db, "--executor", "slurm", "--max-parallel", "2", "--quiet"], Some(&slow));
     until(60, "the submission", || mark.exists().then_some(()));
     kill(submitter);
     let found = tasks(db, "chaos");
@@ -241,7 +243,10 @@ fn killed_submitters_scancel_requeue_and_preemption_lose_nothing_and_run_nothing
         status["failures"].as_array().unwrap().iter().find(|f| f["job_id"] == cancelled_job.as_str()).cloned()
     });
     let error = failure["error"].as_str().unwrap();
-    assert!(error.contains(&format!("task {cancelled_task} ended without a result")) && error.contains("CANCELLED"), "{error}");
+    assert!(
+        error.contains(&format!("task {cancelled_task} ended without a result")) && error.contains("CANCELLED"),
+        "{error}"
+    );
     assert!(error.contains("--retry-failed` continues from the checkpoint"), "{error}");
 
     // 4. A running task requeued, 5. running tasks preempted by a job of the urgent partition
@@ -332,10 +337,16 @@ fn bad_situations_give_clear_errors_and_lose_nothing() {
         "echo 'sbatch: error: Batch job submission failed: Unable to contact slurm controller (connect failure)' >&2\nexit 1",
     );
     let out = sedpack_with_path(&down, &["resume", "bad", "--db", db]);
-    fails_with(out, &["Unable to contact slurm controller", "is slurmctld running", "12 job(s), which are pending again"]);
+    fails_with(
+        out,
+        &["Unable to contact slurm controller", "is slurmctld running", "12 job(s), which are pending again"],
+    );
     pending(12);
     // A submission Slurm rejects.
-    let out = sedpack_with_path(&std::env::var("PATH").unwrap(), &["run", &file, "--db", db, "--sbatch", "--partition=nowhere"]);
+    let out = sedpack_with_path(
+        &std::env::var("PATH").unwrap(),
+        &["run", &file, "--db", db, "--sbatch", "--partition=nowhere"],
+    );
     fails_with(out, &["Invalid partition name specified", "pending again"]);
     pending(12);
     let status = json(&["status", "bad", "--db", db, "--json"]);
@@ -351,15 +362,20 @@ fn bad_situations_give_clear_errors_and_lose_nothing() {
     std::fs::write(result_of(&ids[1]), format!("{{\"result_format\": 1, \"job\": \"{}\"}}", ids[2])).unwrap();
     // A folder the compute node cannot see (not shared): the task cannot even start.
     std::fs::remove_dir_all(run.join("logs")).unwrap();
-    let arrays: Vec<String> = tasks(db, "bad").iter().filter_map(|t| Some(t["task"].as_str()?.split('_').next()?.to_string())).collect();
+    let arrays: Vec<String> =
+        tasks(db, "bad").iter().filter_map(|t| Some(t["task"].as_str()?.split('_').next()?.to_string())).collect();
     shell(&format!("scancel {}", arrays[0]));
     let failures = until(60, "the failures", || {
         let status = json(&["status", "bad", "--db", db, "--json"]);
         (status["failed"] == 12).then(|| status["failures"].as_array().unwrap().clone())
     });
-    let error_of = |job: &str| failures.iter().find(|f| f["job_id"] == job).unwrap()["error"].as_str().unwrap().to_string();
+    let error_of =
+        |job: &str| failures.iter().find(|f| f["job_id"] == job).unwrap()["error"].as_str().unwrap().to_string();
     let truncated = error_of(&ids[0]);
-    assert!(truncated.contains("result.json: not a whole result file (truncated?)") && truncated.contains("set aside"), "{truncated}");
+    assert!(
+        truncated.contains("result.json: not a whole result file (truncated?)") && truncated.contains("set aside"),
+        "{truncated}"
+    );
     assert!(run.join(&ids[0]).join("result.json.rejected").exists());
     let other = error_of(&ids[1]);
     assert!(other.contains(&format!("the result of job {}, not of this folder's job {}", ids[2], ids[1])), "{other}");
@@ -399,7 +415,8 @@ fn bad_situations_give_clear_errors_and_lose_nothing() {
     );
     let job_error = failures[1]["error"].as_str().unwrap();
     assert!(
-        job_error.contains("job.json: No such file") && job_error.contains("must be on a file system that the compute nodes share"),
+        job_error.contains("job.json: No such file")
+            && job_error.contains("must be on a file system that the compute nodes share"),
         "{job_error}"
     );
 }

@@ -102,14 +102,7 @@ impl Store {
     /// Records the executor the campaign's jobs are handed to (None: this machine's workers).
     pub async fn set_executor(&self, name: &str, executor: Option<&Value>) -> Result<(), StoreError> {
         let executor = executor.map(|e| self.encode_json(e, &format!("executor of campaign {name:?}"))).transpose()?;
-        let updated = sqlx::query(sql::SET_EXECUTOR)
-            .bind(name)
-            .bind(executor)
-            .execute(&self.pool)
-            .await
-            .map_err(self.db())?
-            .rows_affected();
-        if updated == 0 {
+        if self.changed(sqlx::query(sql::SET_EXECUTOR).bind(name).bind(executor)).await? == 0 {
             return Err(self.no_campaign(name));
         }
         Ok(())
@@ -229,30 +222,14 @@ impl Store {
     /// Hands a running job from worker `from` to worker `to`; false, changing nothing, if it is
     /// no longer running for `from`.
     pub async fn reassign(&self, job_id: &str, from: &str, to: &str) -> Result<bool, StoreError> {
-        let updated = sqlx::query(sql::REASSIGN_JOB)
-            .bind(job_id)
-            .bind(from)
-            .bind(to)
-            .bind(now())
-            .execute(&self.pool)
-            .await
-            .map_err(self.db())?
-            .rows_affected();
-        Ok(updated == 1)
+        Ok(self.changed(sqlx::query(sql::REASSIGN_JOB).bind(job_id).bind(from).bind(to).bind(now())).await? == 1)
     }
 
     /// Replaces the stored spec of a job that is not done (the same job, described anew); false,
     /// changing nothing, for a done job.
     pub async fn replace_spec(&self, job_id: &str, format: u32, spec: &Value) -> Result<bool, StoreError> {
-        let updated = sqlx::query(sql::REPLACE_SPEC)
-            .bind(job_id)
-            .bind(format)
-            .bind(self.encode_json(spec, &format!("spec of job {job_id}"))?)
-            .execute(&self.pool)
-            .await
-            .map_err(self.db())?
-            .rows_affected();
-        Ok(updated == 1)
+        let spec = self.encode_json(spec, &format!("spec of job {job_id}"))?;
+        Ok(self.changed(sqlx::query(sql::REPLACE_SPEC).bind(job_id).bind(format).bind(spec)).await? == 1)
     }
 
     /// Every job of the campaign in submission order: its stored spec and where it stands.
@@ -376,14 +353,7 @@ impl Store {
     /// Ctrl-C, or the job of a worker the caller knows is gone. Its checkpoint stays, attempts
     /// keep counting. Returns false, changing nothing, if the job had already changed hands.
     pub async fn release(&self, job_id: &str, worker_id: &str) -> Result<bool, StoreError> {
-        let released = sqlx::query(sql::RELEASE_JOB)
-            .bind(job_id)
-            .bind(worker_id)
-            .execute(&self.pool)
-            .await
-            .map_err(self.db())?
-            .rows_affected();
-        Ok(released == 1)
+        Ok(self.changed(sqlx::query(sql::RELEASE_JOB).bind(job_id).bind(worker_id)).await? == 1)
     }
 
     /// The campaign's running jobs with their workers and heartbeats.
@@ -461,13 +431,7 @@ impl Store {
 
     /// Deletes the job's checkpoint; returns whether there was one.
     pub async fn delete_checkpoint(&self, job_id: &str) -> Result<bool, StoreError> {
-        let deleted = sqlx::query(sql::DELETE_CHECKPOINT)
-            .bind(job_id)
-            .execute(&self.pool)
-            .await
-            .map_err(self.db())?
-            .rows_affected();
-        Ok(deleted == 1)
+        Ok(self.changed(sqlx::query(sql::DELETE_CHECKPOINT).bind(job_id)).await? == 1)
     }
 
     /// Counts per state, the failures with their errors and the wall times, from one snapshot.
@@ -584,6 +548,14 @@ impl Store {
         }
         let updated = query.execute(executor).await.map_err(self.db())?.rows_affected();
         if updated == 1 { Ok(()) } else { Err(self.not_owner(job_id, worker_id)) }
+    }
+
+    /// Runs one statement on the pool; gives how many rows it changed.
+    async fn changed(
+        &self,
+        query: sqlx::query::Query<'_, sqlx::Sqlite, sqlx::sqlite::SqliteArguments>,
+    ) -> Result<u64, StoreError> {
+        Ok(query.execute(&self.pool).await.map_err(self.db())?.rows_affected())
     }
 
     fn not_owner(&self, job_id: &str, worker_id: &str) -> StoreError {

@@ -55,19 +55,19 @@ fn workers(requested: Option<usize>) -> anyhow::Result<usize> {
     }
 }
 
-fn report(name: &str, summary: Summary, status: &CampaignStatus) -> std::io::Result<()> {
-    outln!(
-        "{name}: {} job(s) finished now, {} failed now; campaign: {} done, {} failed, {} pending, {} running",
-        summary.completed,
-        summary.failed,
-        status.done,
-        status.failed,
-        status.pending,
-        status.running
-    )?;
+/// HEAD followed by the jobs per state ("running" named `running`), then the failures.
+fn print_states(head: &str, status: &CampaignStatus, running: &str) -> std::io::Result<()> {
+    let s = status;
+    outln!("{head}{} done, {} failed, {} pending, {} {running}", s.done, s.failed, s.pending, s.running)?;
     for f in &status.failures {
         outln!("  failed {}: {}", f.job_id, f.error)?;
     }
+    Ok(())
+}
+
+fn report(name: &str, summary: Summary, status: &CampaignStatus) -> std::io::Result<()> {
+    let head = format!("{name}: {} job(s) finished now, {} failed now; campaign: ", summary.completed, summary.failed);
+    print_states(&head, status, "running")?;
     if summary.interrupted {
         outln!("interrupted: run `sedpack resume {name}` to finish the campaign")?;
     }
@@ -103,6 +103,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
             Err(e) => return Err(e.into()),
         };
         let executor = flags.over(campaign.executor.clone()).resolve(previous.as_ref());
+        check_workers(args.workers, &executor)?;
         store.upsert_campaign(&campaign.name, &campaign.text).await?;
         switch_executor(&store, &campaign.name, previous.as_ref(), &executor).await?;
         let added = add_jobs(&store, &campaign).await?;
@@ -123,6 +124,13 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         }
         continue_campaign(&store, &args.db, &campaign.name, &executor, args.workers, &args.common, interval).await
     })
+}
+
+fn check_workers(workers: Option<usize>, executor: &Executor) -> anyhow::Result<()> {
+    if workers.is_some() && matches!(executor, Executor::Slurm(_)) {
+        bail!("--workers applies to the local executor; a Slurm task runs one packing on --cpus-per-task threads");
+    }
+    Ok(())
 }
 
 /// Records the executor the campaign runs on from now; refuses to change it while jobs run on
@@ -209,9 +217,6 @@ async fn continue_campaign(
             return report(name, summary, &store.status(name).await?).map_err(Into::into);
         }
     };
-    if workers_asked.is_some() {
-        bail!("--workers applies to the local executor; a Slurm task runs one packing on --cpus-per-task threads");
-    }
     let run = RunDir::of(db, name)?;
     slurm::sync(store, &run, name).await?;
     retry_failed(store, name, common.retry_failed).await?;
@@ -225,16 +230,7 @@ async fn continue_campaign(
     }
     let followed = if common.wait { Some(slurm::follow(&submission, !common.quiet).await?) } else { None };
     let status = store.status(name).await?;
-    outln!(
-        "{name}: {} done, {} failed, {} pending, {} in Slurm",
-        status.done,
-        status.failed,
-        status.pending,
-        status.running
-    )?;
-    for f in &status.failures {
-        outln!("  failed {}: {}", f.job_id, f.error)?;
-    }
+    print_states(&format!("{name}: "), &status, "in Slurm")?;
     match followed {
         None if status.running > 0 => {
             outln!("follow it with `sedpack status {name}`; `sedpack resume {name} --wait` waits for it")?
@@ -261,6 +257,7 @@ pub fn resume(args: &ResumeArgs) -> anyhow::Result<()> {
     runtime()?.block_on(async {
         let store = open_existing(&args.db).await?;
         let executor = Executor::from_stored(store.campaign(&args.name).await?.executor.as_ref())?;
+        check_workers(args.workers, &executor)?;
         start_log(&args.db)?;
         continue_campaign(&store, &args.db, &args.name, &executor, args.workers, &args.common, interval).await
     })
