@@ -143,7 +143,7 @@ async fn switch_executor(
 ) -> anyhow::Result<()> {
     let was_slurm = matches!(previous, Some(Executor::Slurm(_)));
     let is_slurm = matches!(executor, Executor::Slurm(_));
-    if was_slurm != is_slurm && previous.is_some() {
+    if let Some(previous) = previous.filter(|_| was_slurm != is_slurm) {
         if !was_slurm {
             // Jobs of local runners that died are not running any more.
             runner::recover(store, name).await?;
@@ -153,8 +153,7 @@ async fn switch_executor(
             let how =
                 if was_slurm { format!("wait for them or `sedpack cancel {name}`") } else { "let them end".into() };
             bail!(
-                "{name}: {running} job(s) are running on {}: {how} before running the campaign on {executor}",
-                previous.expect("a previous executor")
+                "{name}: {running} job(s) are running on {previous}: {how} before running the campaign on {executor}"
             );
         }
     }

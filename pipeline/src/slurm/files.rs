@@ -370,7 +370,7 @@ mod tests {
         };
         job.append_event(&event).unwrap();
         OpenOptions::new().append(true).open(job.events_file()).unwrap().write_all(b"{\"task\": \"7_").unwrap();
-        assert_eq!(job.events(), [event.clone()]);
+        assert_eq!(job.events(), std::slice::from_ref(&event));
         let done = Event { kind: EventKind::Done, ..event.clone() };
         job.append_event(&done).unwrap();
         assert_eq!(job.events(), [event, done]);

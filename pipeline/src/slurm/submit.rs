@@ -58,12 +58,10 @@ impl Submission<'_> {
                     for (k, job) in jobs.iter().enumerate() {
                         self.store.release(&job.id, &handle(k).to_string()).await?;
                     }
+                    let pending = self.store.status(self.campaign).await?.pending;
                     let kept = submitted.iter().map(|s: &Submitted| s.array.as_str()).collect::<Vec<_>>().join(", ");
                     let kept = if kept.is_empty() { String::new() } else { format!(" (arrays {kept} were submitted)") };
-                    return Err(e.context(format!(
-                        "nothing was submitted for {} job(s), which are pending again{kept}",
-                        jobs.len()
-                    )));
+                    return Err(e.context(format!("nothing more was submitted: {pending} job(s) are pending{kept}")));
                 }
             };
             for (k, job) in jobs.iter().enumerate() {
