@@ -197,6 +197,49 @@ pub fn scatter(plot: &ScatterPlot) -> Result<String, PlotError> {
     })
 }
 
+/// One series of [`series_with_spread`]: a label and its points (x, mean y, std of y).
+pub struct Series {
+    pub label: String,
+    pub points: Vec<(f64, f64, f64)>,
+}
+
+/// Series of means joined in order of x, each point with a bar of ± one standard deviation
+/// (Fig. 10: porosity against the inverse equancy, one series per grain shape).
+pub fn series_with_spread(title: &str, x_label: &str, y_label: &str, series: &[Series]) -> Result<String, PlotError> {
+    render("series plot", (640, 480), |root| {
+        let all = || series.iter().flat_map(|s| s.points.iter());
+        let x = padded_range(all().map(|p| p.0));
+        let y = padded_range(all().flat_map(|p| [p.1 - p.2, p.1 + p.2]));
+        let mut chart = chart(root, title, 19, x, y)?;
+        axes(&mut chart, x_label, y_label, x, y)?;
+        for (k, s) in series.iter().enumerate() {
+            let colour = match k {
+                0 => STEEL,
+                1 => ORANGE,
+                2 => RGBColor(40, 150, 70),
+                _ => {
+                    let (r, g, b) = Palette99::pick(k).rgb();
+                    RGBColor(r, g, b)
+                }
+            };
+            let mut points = s.points.clone();
+            points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            chart.draw_series(LineSeries::new(points.iter().map(|p| (p.0, p.1)), colour.stroke_width(1)))?;
+            chart.draw_series(
+                points
+                    .iter()
+                    .filter(|p| p.2 > 0.0)
+                    .map(|p| ErrorBar::new_vertical(p.0, p.1 - p.2, p.1, p.1 + p.2, colour.stroke_width(1), 6)),
+            )?;
+            chart
+                .draw_series(points.iter().map(|p| Circle::new((p.0, p.1), 4, colour.filled())))?
+                .label(s.label.as_str())
+                .legend(move |(x, y)| Circle::new((x + 7, y), 4, colour.filled()));
+        }
+        legend(&mut chart, 13)
+    })
+}
+
 /// Predicted against observed porosity with the 1:1 line (Figs. 9 and 12): the model fitted on
 /// all rows, and each row's held-out cross-validation prediction.
 pub fn predicted_vs_observed(

@@ -303,3 +303,50 @@ fn too_few_packings_still_give_a_report_that_says_why() {
     let empty = report("empty", &[], out.path());
     assert_eq!(std::fs::read_to_string(empty.dataset).unwrap(), "job_id,porosity\n");
 }
+
+/// Fig. 10: two forms packed as ellipsoids and as meshes, porosities chosen so that means,
+/// spreads and differences are worked by hand.
+#[test]
+fn a_campaign_over_grain_shapes_compares_them_at_equal_form() {
+    let runs = [
+        ("ellipsoid", 0.8, [0.360, 0.364].as_slice()),
+        ("mesh", 0.8, &[0.350, 0.352]),
+        ("ellipsoid", 0.5, &[0.400]),
+        ("mesh", 0.5, &[0.405, 0.409, 0.407]),
+    ];
+    let mut records = Vec::new();
+    for (shape, form, porosities) in runs {
+        for (seed, n) in porosities.iter().enumerate() {
+            records.push(JobRecord {
+                job_id: format!("{shape}-{form}-{seed}"),
+                porosity: *n,
+                profile: vec![],
+                parameters: BTreeMap::from([
+                    ("grains.shape".into(), json!(shape)),
+                    ("grains.form".into(), json!({"fl": form, "el": form})),
+                    ("seed".into(), json!(seed + 1)),
+                ]),
+                grain_statistics: grain_statistics(&[(form, form); 3]),
+                experiment: None,
+            });
+        }
+    }
+    let out = tempfile::tempdir().unwrap();
+    let files = report("shapes", &records, out.path());
+    let md = std::fs::read_to_string(&files.markdown).unwrap();
+    // L/S = 1/(FL·EL): 1/0.64 = 1.5625 and 1/0.25 = 4. Form 0.8: 0.362 ± 0.002 against
+    // 0.351 ± 0.001, difference −0.011; form 0.5: 0.400 against 0.407 ± 0.00163, +0.007.
+    // RMS of (−0.011, +0.007) = √(8.5e-5) = 0.00922.
+    assert!(
+        md.contains(r#"| grains.form = {"fl":0.8,"el":0.8} | 1.56 | 0.362 ± 0.002 (2) | 0.351 ± 0.001 (2) | -0.011 |"#),
+        "{md}"
+    );
+    assert!(
+        md.contains(r#"| grains.form = {"fl":0.5,"el":0.5} | 4.00 | 0.400 ± 0.000 (1) | 0.407 ± 0.002 (3) | +0.007 |"#),
+        "{md}"
+    );
+    assert!(md.contains("RMS difference `mesh` − `ellipsoid` over 2 setups: 0.0092."), "{md}");
+    assert!(files.figures.iter().any(|f| f.ends_with("shapes.svg")));
+    let svg = check_html(out.path(), 3);
+    assert!(svg.contains("Porosity by grain shape"));
+}

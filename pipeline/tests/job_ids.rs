@@ -29,4 +29,13 @@ fn campaign_files_give_the_job_ids_of_version_0_1_0() {
             assert_eq!(job.id, want["id"].as_str().unwrap(), "{file}");
         }
     }
+    // The validation campaign's grid was reordered since (seeds outermost): the same jobs, in another order.
+    let ids = |jobs: &[sedpack::campaign::PlannedJob]| {
+        let mut ids: Vec<String> = jobs.iter().map(|j| j.id.clone()).collect();
+        ids.sort();
+        ids
+    };
+    let reordered = sedpack::campaign::read_campaign(repo("campaigns/validation-cylinder.yaml").as_ref()).unwrap();
+    let frozen = sedpack::campaign::read_campaign(&fixture("job-ids/validation-cylinder.yaml")).unwrap();
+    assert_eq!(ids(&reordered.jobs), ids(&frozen.jobs));
 }

@@ -891,6 +891,9 @@ impl Polygon {
             let j = (i + 1) % self.len;
             let fj = f(&old[j]);
             if fi >= 0.0 {
+                if len == POLYGON_CORNERS {
+                    return None;
+                }
                 new[len] = old[i];
                 len += 1;
             }
@@ -959,6 +962,29 @@ mod tests {
             cell.face(&normal, &f.map(|k| v[k])).unwrap();
         }
         cell.bound();
+    }
+
+    #[test]
+    fn a_polygon_cut_into_more_corners_than_it_holds_gives_up_instead_of_overflowing() {
+        // n planes tangent to a circle of radius 0.8 inside a triangle of inradius 1 leave the
+        // regular n-gon around the circle, which has n corners.
+        let tangent = |angle: f64, radius: f64| move |x: &V3| radius - (angle.cos() * x.x + angle.sin() * x.y);
+        let step = std::f64::consts::TAU / POLYGON_CORNERS as f64;
+        let full = || {
+            let mut polygon = Polygon::new();
+            let s = 3f64.sqrt();
+            polygon.reset(&[V3::new(0.0, 2.0, 0.0), V3::new(-s, -1.0, 0.0), V3::new(s, -1.0, 0.0)]);
+            for k in 0..POLYGON_CORNERS {
+                polygon.clip(tangent(k as f64 * step, 0.8)).expect("fits");
+            }
+            polygon
+        };
+        assert_eq!(full().corners().len(), POLYGON_CORNERS);
+        // Cutting off any one corner would make one more than fit, wherever it lies in the list.
+        for k in 0..POLYGON_CORNERS {
+            let mut polygon = full();
+            assert!(polygon.clip(tangent((k as f64 + 0.5) * step, 0.805)).is_none(), "corner {k}");
+        }
     }
 
     #[test]
