@@ -1,21 +1,34 @@
-//! The stored job: the JSON a job keeps in the database and whose hash is its id. Its format
-//! is written out here type by type, apart from the solver's types, so that changing those
-//! never changes a stored job or an id; every value is concrete (the paper's rules already
-//! applied), so a job runs the same whatever later versions take as defaults.
+//! The stored job: the JSON a job keeps in the database (and, for a Slurm task, in its job
+//! folder), and the identity whose hash is its id. Its format is written out here type by type,
+//! apart from the solver's types, so that changing those never changes a stored job or an id;
+//! every value is concrete (the paper's rules already applied), so a job runs the same whatever
+//! later versions take as defaults.
 //!
-//! Format 1 is the JSON of sedpack 0.1.0, byte for byte. A new format gets a new number (the
-//! `format` column of the jobs table) and its own types beside these.
+//! - Format 1 is the JSON of sedpack 0.1.0, byte for byte. A mesh folder is its absolute path,
+//!   so the id of such a job changed when the folder moved.
+//! - Format 2 (this version's) is `{"job": IDENTITY, "mesh_folder": PATH or null}`. IDENTITY is
+//!   format 1's JSON with a mesh folder named `folder` (its digest pins the meshes); the folder's
+//!   place is `mesh_folder`, outside the id. IDENTITY is byte for byte format 1's JSON for every
+//!   job without a mesh folder, so those ids are 0.1.0's.
+//!
+//! A stored format is frozen: a release that adds a field writes a new format with its own types
+//! beside these, keeps reading every older one (giving the new field the value that reproduces
+//! the older behaviour) and keeps the identity of jobs that leave the field at that value.
 
 use anyhow::{Context, bail};
 use nalgebra::Vector3;
+use sha2::{Digest, Sha256};
 use solver::dem::{Calibration, Domain, Material, Shaking};
 use solver::grain::{FormDistribution, MeshLibrary, SieveCurve, Table3Case};
 use solver::packing::{FormSpec, GrainSpec, PackingSpec, Process, ShapeKind};
 
+use crate::meshes;
 use crate::spec::JobSpec;
 
 /// The format this version writes.
-pub const FORMAT: u32 = 1;
+pub const FORMAT: u32 = 2;
+/// A mesh folder's name in a format 2 identity.
+const FOLDER: &str = "folder";
 
 /// Format 1, the JSON of sedpack 0.1.0.
 mod v1 {
@@ -140,23 +153,67 @@ mod v1 {
     }
 }
 
-/// The stored JSON of a job, in format [`FORMAT`].
-pub fn encode(job: &JobSpec) -> serde_json::Value {
-    serde_json::to_value(stored(job)).expect("the stored job is plain numbers, strings and lists")
+/// Format 2: format 1's job with the place of its mesh folder taken out of it.
+mod v2 {
+    use serde::{Deserialize, Serialize};
+
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub(super) struct Job {
+        /// Format 1's job with a mesh folder named `folder`: what the id hashes.
+        pub(super) job: super::v1::Job,
+        /// The mesh folder's absolute path when the job was (last) submitted.
+        pub(super) mesh_folder: Option<String>,
+    }
 }
 
-/// The stored JSON as text: the input of the job id.
+/// The stored JSON of a job, in format [`FORMAT`].
+pub fn encode(job: &JobSpec) -> serde_json::Value {
+    let mesh_folder = job.packing.grains.meshes.as_ref().map(|m| m.source.clone()).filter(|s| !meshes::is_builtin(s));
+    serde_json::to_value(v2::Job { job: identity(job), mesh_folder })
+        .expect("the stored job is plain numbers, strings and lists")
+}
+
+/// The JSON the job id hashes: the job without the place of its mesh folder.
 pub fn canonical_json(job: &JobSpec) -> String {
-    serde_json::to_string(&stored(job)).expect("the stored job is plain numbers, strings and lists")
+    serde_json::to_string(&identity(job)).expect("the stored job is plain numbers, strings and lists")
+}
+
+/// Stable id of a resolved job: the first 16 hex digits of the SHA-256 of its identity (which
+/// includes the campaign name, so ids never collide across campaigns).
+pub fn job_id(job: &JobSpec) -> String {
+    let digest = Sha256::digest(canonical_json(job).as_bytes());
+    digest.iter().take(8).map(|b| format!("{b:02x}")).collect()
 }
 
 /// The job a stored JSON of the given format describes. Its meshes, if any, are only named: the
 /// caller loads them again.
 pub fn decode(format: u32, json: &serde_json::Value) -> anyhow::Result<JobSpec> {
-    if format != FORMAT {
-        bail!("the job is stored in format {format}, which this version of sedpack (format {FORMAT}) cannot read");
+    match format {
+        1 => from_v1(serde_json::from_value(json.clone()).context("the stored job is not format 1")?),
+        2 => {
+            let v2::Job { mut job, mesh_folder } =
+                serde_json::from_value(json.clone()).context("the stored job is not format 2")?;
+            let named = job.packing.grains.meshes.as_mut().map(|m| &mut m.source);
+            match (named, mesh_folder) {
+                (Some(source), Some(folder)) if source == FOLDER => *source = folder,
+                (Some(source), None) if meshes::is_builtin(source) => {}
+                (None, None) => {}
+                (source, folder) => bail!(
+                    "the stored job names its meshes {source:?} with the mesh folder {folder:?}: format 2 \
+                     names a builtin library without a folder, or `{FOLDER}` with one"
+                ),
+            }
+            from_v1(job)
+        }
+        _ => bail!(
+            "the job is stored in format {format}, which this version of sedpack (formats 1 to {FORMAT}) \
+             cannot read: a newer sedpack stored it"
+        ),
     }
-    let job: v1::Job = serde_json::from_value(json.clone()).context("the stored job is not format 1")?;
+}
+
+fn from_v1(job: v1::Job) -> anyhow::Result<JobSpec> {
     let p = job.packing;
     let time_step = p.time_step;
     let calibration = match p.calibration {
@@ -239,7 +296,8 @@ pub fn decode(format: u32, json: &serde_json::Value) -> anyhow::Result<JobSpec> 
     Ok(JobSpec { name: job.name, packing, experiment })
 }
 
-fn stored(job: &JobSpec) -> v1::Job {
+/// The job in format 1's types, a mesh folder named `folder`.
+fn identity(job: &JobSpec) -> v1::Job {
     let spec = &job.packing;
     let derived = spec.derived();
     let grains = &spec.grains;
@@ -274,7 +332,7 @@ fn stored(job: &JobSpec) -> v1::Job {
                     FormSpec::Own => v1::Form::Own,
                 },
                 meshes: grains.meshes.as_ref().map(|l| v1::Meshes {
-                    source: l.source.clone(),
+                    source: if meshes::is_builtin(&l.source) { l.source.clone() } else { FOLDER.into() },
                     faces: l.faces,
                     digest: l.digest.clone(),
                 }),
@@ -314,12 +372,23 @@ fn stored(job: &JobSpec) -> v1::Job {
 
 #[cfg(test)]
 mod tests {
+    use solver::grain::MeshLibrary;
     use solver::packing::DomainKind;
 
     use super::*;
 
     fn job(packing: PackingSpec) -> JobSpec {
         JobSpec { name: "j".into(), packing, experiment: Some(analysis::Experiment { porosity: 0.37, std: None }) }
+    }
+
+    /// A job of meshes from a folder at `place`; its meshes are named, not loaded.
+    fn folder_job(place: &str) -> JobSpec {
+        let mut packing = PackingSpec::paper(DomainKind::Periodic);
+        packing.grains.shape = ShapeKind::Mesh;
+        packing.grains.form = FormSpec::Own;
+        packing.grains.meshes =
+            Some(MeshLibrary { source: place.into(), faces: 100, digest: "0123abcd".into(), meshes: Vec::new() });
+        job(packing)
     }
 
     #[test]
@@ -338,17 +407,60 @@ mod tests {
     }
 
     #[test]
+    fn a_job_without_a_mesh_folder_keeps_its_format_1_identity() {
+        let original = job(PackingSpec::paper(DomainKind::Periodic));
+        let stored = encode(&original);
+        assert_eq!(stored["mesh_folder"], serde_json::Value::Null);
+        assert_eq!(serde_json::to_string(&stored["job"]).unwrap(), canonical_json(&original));
+        // Format 1 is the identity itself, and reads back as the same job.
+        let v1: serde_json::Value = serde_json::from_str(&canonical_json(&original)).unwrap();
+        assert_eq!(job_id(&decode(1, &v1).unwrap()), job_id(&original));
+    }
+
+    #[test]
+    fn a_mesh_folder_moves_without_changing_the_id() {
+        let (here, there) = (folder_job("/data/scans"), folder_job("/scratch/me/scans"));
+        assert_eq!(job_id(&here), job_id(&there));
+        let stored = encode(&there);
+        assert_eq!(stored["job"]["packing"]["grains"]["meshes"]["source"], "folder");
+        assert_eq!(stored["mesh_folder"], "/scratch/me/scans");
+        let back = decode(FORMAT, &stored).unwrap();
+        assert_eq!(back.packing.grains.meshes.unwrap().source, "/scratch/me/scans");
+        // Another digest is another job.
+        let mut other = folder_job("/data/scans");
+        other.packing.grains.meshes.as_mut().unwrap().digest = "ffff".into();
+        assert_ne!(job_id(&other), job_id(&here));
+        // sedpack 0.1.0 stored the folder's path in the job (format 1): read back, it is the job
+        // of the same identity.
+        let mut v1 = stored["job"].clone();
+        v1["packing"]["grains"]["meshes"]["source"] = "/old/place/scans".into();
+        let old = decode(1, &v1).unwrap();
+        assert_eq!(old.packing.grains.meshes.as_ref().unwrap().source, "/old/place/scans");
+        assert_eq!(job_id(&old), job_id(&here));
+    }
+
+    #[test]
     fn stored_jobs_that_disagree_with_themselves_or_another_format_are_refused() {
         let stored = encode(&job(PackingSpec::paper(DomainKind::Periodic)));
-        let error = decode(2, &stored).unwrap_err().to_string();
-        assert!(error.contains("format 2"), "{error}");
+        let error = decode(3, &stored).unwrap_err().to_string();
+        assert!(error.contains("format 3") && error.contains("formats 1 to 2"), "{error}");
+        let error = format!("{:#}", decode(1, &stored).unwrap_err());
+        assert!(error.contains("not format 1"), "{error}");
         let mut two_steps = stored.clone();
-        two_steps["packing"]["calibration"]["Discrete"]["time_step"] = serde_json::json!(1e-5);
+        two_steps["job"]["packing"]["calibration"]["Discrete"]["time_step"] = serde_json::json!(1e-5);
         let error = decode(FORMAT, &two_steps).unwrap_err().to_string();
         assert!(error.contains("1e-5") || error.contains("0.00001"), "{error}");
-        let mut renamed = stored;
-        renamed["size_case"] = serde_json::json!("U7");
+        let mut renamed = stored.clone();
+        renamed["job"]["size_case"] = serde_json::json!("U7");
         let error = decode(FORMAT, &renamed).unwrap_err().to_string();
         assert!(error.contains("size case U7"), "{error}");
+        // A folder without its place, or a place without a folder.
+        let mut placeless = encode(&folder_job("/data/scans"));
+        placeless["mesh_folder"] = serde_json::Value::Null;
+        let error = decode(FORMAT, &placeless).unwrap_err().to_string();
+        assert!(error.contains("\"folder\"") && error.contains("None"), "{error}");
+        let mut stray = stored;
+        stray["mesh_folder"] = "/data/scans".into();
+        assert!(decode(FORMAT, &stray).is_err());
     }
 }
