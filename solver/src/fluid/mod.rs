@@ -1,0 +1,204 @@
+//! Fluid forces on the grains, after the second paper (Sun & Xiao §2.3–2.4): drag per
+//! component sphere by Syamlal et al. with the local fluid fraction (Eqs. 3–7), Saffman lift
+//! (Eq. 8), summed into force and torque at the grain; in a prescribed fluid velocity field
+//! (still water, a uniform stream, a laminar or logarithmic channel profile over the bed).
+//! Buoyancy stays where it was, in the engine's gravity minus buoyancy (Eq. 10 of the first
+//! paper), with the same fluid density.
+//!
+//! Per step, as a stage of [`crate::dem::Simulation::step`] when fluid forces are on: the
+//! grains' volumes are spread over a coarse grid for the fluid fraction ([`fraction`]), the bed
+//! surface is found where a channel profile needs it, then every body gets its fluid force and
+//! torque:
+//! - a sphere and each component sphere of a bonded grain: drag (Eqs. 3–7) and lift (Eq. 8) at
+//!   its centre, with the velocity of that point of the grain; a bonded grain's spheres are
+//!   sheltered by the wakes of its own spheres upstream ([`shielding`], sedpack's model);
+//! - an ellipsoid or a polyhedron, which is not made of spheres: Haider & Levenspiel's (1989)
+//!   drag curve for its sphericity under the same hindrance, and lift as on the sphere of equal
+//!   volume, at its centre, so no torque: such a grain keeps the orientation it has.
+
+pub mod drag;
+pub mod flow;
+pub mod fraction;
+pub mod lift;
+pub mod shielding;
+pub mod sphericity;
+
+use nalgebra::{UnitQuaternion, Vector3};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use self::drag::{FluidProperties, HaiderLevenspiel, SyamlalOBrien};
+use self::flow::Flow;
+use self::fraction::{FractionGrid, Stencil};
+use self::lift::SaffmanLift;
+use self::shielding::{WetSphere, shelter};
+use crate::dem::{Bodies, Domain, Shape};
+use crate::porosity;
+
+/// Water at 20 °C: density (kg/m³) and dynamic viscosity (Pa·s), IAPWS values.
+pub const WATER_20C: FluidProperties = FluidProperties { density: 998.21, viscosity: 1.0016e-3 };
+
+/// The fluid forces of a simulation: the fluid's viscosity (its density is the material's
+/// `fluid_density`, the same as buoyancy's), the prescribed flow and the averaging.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Fluid {
+    /// Dynamic viscosity μ (Pa·s).
+    pub viscosity: f64,
+    pub flow: Flow,
+    /// Saffman lift (Eq. 8) on or off.
+    pub lift: bool,
+    /// Side of the fluid-fraction grid's cells (m), a few grain sizes.
+    pub cell: f64,
+    /// Slice height and cut-off porosity of the bed surface of §4.4 (the first paper), from
+    /// which channel profiles are measured.
+    pub slice: f64,
+    pub cutoff: f64,
+}
+
+/// A body's fluid force and torque (about its centre of mass) of one step.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct FluidLoad {
+    pub force: Vector3<f64>,
+    pub torque: Vector3<f64>,
+}
+
+/// The fluid stage's working memory, owned by the step pipeline: filled afresh every step.
+#[derive(Debug, Clone, Default)]
+pub struct Scratch {
+    grid: FractionGrid,
+    /// Per body: diameter of the sphere of equal volume and, for a body that is not made of
+    /// spheres, its drag curve (shapes never change, so this is computed once per body).
+    drag_shape: Vec<(f64, Option<HaiderLevenspiel>)>,
+    /// Volume-equivalent spheres (height, radius) for the bed surface.
+    spheres: Vec<(f64, f64)>,
+    /// Height of the bed surface the profiles are measured from (m).
+    pub bed: f64,
+    /// This step's fluid force and torque of each body.
+    pub loads: Vec<FluidLoad>,
+}
+
+impl Fluid {
+    /// The fluid forces on every body this step, into `scratch.loads`.
+    pub fn apply(&self, bodies: &Bodies, domain: &Domain, density: f64, scratch: &mut Scratch) {
+        let fluid = FluidProperties { density, viscosity: self.viscosity };
+        let n = bodies.len();
+        for k in scratch.drag_shape.len()..n {
+            let shape = &bodies.shape[k];
+            let curve = matches!(shape, Shape::Ellipsoid { .. } | Shape::Polyhedron(_))
+                .then(|| HaiderLevenspiel::new(sphericity::sphericity(shape)));
+            scratch.drag_shape.push((2.0 * shape.equivalent_radius(), curve));
+        }
+        scratch.drag_shape.truncate(n);
+
+        let top = (0..n).map(|k| bodies.position[k].z + bodies.bounding_radius[k]).fold(0.0, f64::max);
+        scratch.grid.reset(domain, self.cell, top);
+        for k in 0..n {
+            for (center, _, volume) in pieces(&bodies.shape[k], &bodies.position[k], &bodies.orientation[k]) {
+                let stencil = scratch.grid.stencil(&center);
+                scratch.grid.deposit(&stencil, volume);
+            }
+        }
+        scratch.bed = if self.flow.needs_bed() { self.bed_surface(bodies, domain, &mut scratch.spheres) } else { 0.0 };
+
+        let (grid, drag_shape, bed) = (&scratch.grid, &scratch.drag_shape, scratch.bed);
+        scratch.loads.resize(n, FluidLoad::default());
+        scratch.loads.par_iter_mut().enumerate().for_each_init(Default::default, |wet, (k, load)| {
+            *load = match drag_shape[k] {
+                (diameter, Some(curve)) => self.single_body(bodies, k, diameter, curve, grid, bed, &fluid),
+                (_, None) => self.spheres(bodies, k, grid, bed, &fluid, wet),
+            };
+        });
+    }
+
+    /// Haider & Levenspiel's drag and the lift of the sphere of equal volume at the centre.
+    #[allow(clippy::too_many_arguments)]
+    fn single_body(
+        &self,
+        bodies: &Bodies,
+        k: usize,
+        diameter: f64,
+        curve: HaiderLevenspiel,
+        grid: &FractionGrid,
+        bed: f64,
+        fluid: &FluidProperties,
+    ) -> FluidLoad {
+        let x = bodies.position[k];
+        let volume = bodies.volume[k];
+        let stencil = grid.stencil(&x);
+        let fraction = grid.fluid_fraction(&stencil, volume * stencil.overlap(&stencil));
+        let (velocity, vorticity) = self.flow.at(&x, bed, fluid.kinematic_viscosity());
+        let slip = velocity - bodies.velocity[k];
+        let mut force = SyamlalOBrien { curve }.force(fluid, diameter, volume, fraction, &slip);
+        if self.lift {
+            force += SaffmanLift::PAPER.force(fluid, diameter, &slip, &vorticity);
+        }
+        FluidLoad { force, torque: Vector3::zeros() }
+    }
+
+    /// Drag and lift on each sphere of a sphere or bonded grain, summed at the centre of mass.
+    fn spheres(
+        &self,
+        bodies: &Bodies,
+        k: usize,
+        grid: &FractionGrid,
+        bed: f64,
+        fluid: &FluidProperties,
+        (wet, stencils): &mut (Vec<WetSphere>, Vec<Stencil>),
+    ) -> FluidLoad {
+        let x = bodies.position[k];
+        let nu = fluid.kinematic_viscosity();
+        wet.clear();
+        stencils.clear();
+        for (center, radius, _) in pieces(&bodies.shape[k], &x, &bodies.orientation[k]) {
+            let (velocity, _) = self.flow.at(&center, bed, nu);
+            let slip = velocity - bodies.point_velocity(k, &(center - x));
+            wet.push(WetSphere { center, radius, slip });
+            stencils.push(grid.stencil(&center));
+        }
+        shelter(wet, nu);
+        let mut load = FluidLoad::default();
+        for (sphere, stencil) in wet.iter().zip(stencils.iter()) {
+            let own: f64 =
+                wet.iter().zip(stencils.iter()).map(|(s, t)| ball_volume(s.radius) * t.overlap(stencil)).sum();
+            let fraction = grid.fluid_fraction(stencil, own);
+            let d = 2.0 * sphere.radius;
+            let mut f = SyamlalOBrien::SPHERES.force(fluid, d, ball_volume(sphere.radius), fraction, &sphere.slip);
+            if self.lift {
+                let (_, vorticity) = self.flow.at(&sphere.center, bed, nu);
+                f += SaffmanLift::PAPER.force(fluid, d, &sphere.slip, &vorticity);
+            }
+            load.force += f;
+            load.torque += (sphere.center - x).cross(&f);
+        }
+        load
+    }
+
+    /// The free surface of §4.4 (first paper) over the bodies as volume-equivalent spheres: the
+    /// height where the solid fraction falls through 1 − cut-off from the top down; the floor
+    /// while no bed has formed.
+    fn bed_surface(&self, bodies: &Bodies, domain: &Domain, spheres: &mut Vec<(f64, f64)>) -> f64 {
+        spheres.clear();
+        spheres.extend((0..bodies.len()).map(|k| (bodies.position[k].z, bodies.shape[k].equivalent_radius())));
+        let fraction = porosity::solid_fractions(spheres, domain.cross_section(), self.slice);
+        porosity::surface_index(&fraction, 1.0 - self.cutoff).map_or(0.0, |k| k as f64 * self.slice)
+    }
+}
+
+/// Centres (world), radii and volumes of the spheres that make a body for the fluid: its
+/// component spheres if bonded, else the body itself at its centre as the sphere of equal volume.
+fn pieces<'a>(
+    shape: &'a Shape,
+    x: &'a Vector3<f64>,
+    q: &'a UnitQuaternion<f64>,
+) -> impl Iterator<Item = (Vector3<f64>, f64, f64)> + 'a {
+    let bonded = match shape {
+        Shape::Bonded(b) => &b.spheres[..],
+        _ => &[],
+    };
+    let whole = bonded.is_empty().then(|| (*x, shape.equivalent_radius(), shape.volume()));
+    whole.into_iter().chain(bonded.iter().map(move |c| (x + q * c.center, c.radius, c.volume())))
+}
+
+fn ball_volume(radius: f64) -> f64 {
+    4.0 / 3.0 * std::f64::consts::PI * radius.powi(3)
+}
