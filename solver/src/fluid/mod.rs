@@ -20,6 +20,7 @@ pub mod drag;
 pub mod flow;
 pub mod fraction;
 pub mod lift;
+pub mod settling;
 pub mod shielding;
 pub mod sphericity;
 
