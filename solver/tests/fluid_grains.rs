@@ -3,15 +3,17 @@
 
 use std::sync::OnceLock;
 
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::Vector3;
 use solver::dem::{Material, Shape};
-use solver::fluid::WATER_20C;
-use solver::fluid::settling::{Drop, Scales, Settling, dietrich_velocity, drop, haider_levenspiel_velocity};
+use solver::fluid::WATER;
+use solver::fluid::settling::{
+    Drop, Scales, Settling, dietrich_velocity, drop, haider_levenspiel_velocity, release_orientation,
+};
 use solver::fluid::sphericity::sphericity;
 use solver::grain::{FormParameters, ZinggClass, bonded_grain};
 
 fn material() -> Material {
-    Material { fluid_density: WATER_20C.density, ..Material::default() }
+    Material::default()
 }
 
 /// A grain of each class (full axes in mm), nominal diameters 2.6–4.3 mm as in the paper's
@@ -25,12 +27,6 @@ const GRAINS: [(&str, [f64; 3]); 7] = [
     ("equant-3", [4.0, 3.8, 3.0]),
     ("equant-4", [5.0, 4.0, 3.0]),
 ];
-
-/// Released tilted: 40° about the long axis, then 25° about the world y axis.
-fn tilted() -> UnitQuaternion<f64> {
-    UnitQuaternion::from_axis_angle(&Vector3::y_axis(), 25f64.to_radians())
-        * UnitQuaternion::from_axis_angle(&Vector3::x_axis(), 40f64.to_radians())
-}
 
 struct Case {
     class: ZinggClass,
@@ -49,8 +45,8 @@ fn cases() -> &'static [Case] {
                 let run = Drop {
                     shape: Shape::from(&grain),
                     material: material(),
-                    viscosity: WATER_20C.viscosity,
-                    orientation: tilted(),
+                    viscosity: WATER.viscosity,
+                    orientation: release_orientation(),
                 };
                 Case { class: grain.class, form, settling: drop(&run).expect("a lone grain settles") }
             })
@@ -68,7 +64,7 @@ fn bonded_grains_of_every_zingg_class_settle_as_haider_and_levenspiel_say() {
     // disks of one shape factor settle quite differently); we accept ±20 % in u_t, i.e. C_D
     // between 0.69 and 1.56 times theirs. Measured: u_t/u_HL = 0.905 (disk), 0.918 (blade),
     // 1.069 (rod), 0.935, 0.947, 0.872, 0.871 (equant-1 … 4), at Re_p 780–1430.
-    let scales = Scales::new(&WATER_20C, 2650.0, 9.81);
+    let scales = Scales::new(&WATER, 2650.0, 9.81);
     for (case, (name, _)) in cases().iter().zip(GRAINS) {
         assert_eq!(case.class.name(), name);
         let s = &case.settling;

@@ -9,11 +9,11 @@ use solver::dem::{Calibration, Domain, Material, NewBody, Settings, Shape, Simul
 use solver::fluid::drag::FluidProperties;
 use solver::fluid::flow::Flow;
 use solver::fluid::settling::{Drop, Settling, drop, sphere_terminal_velocity};
-use solver::fluid::{Fluid, WATER_20C};
+use solver::fluid::{Fluid, WATER};
 
-/// Quartz in water at 20 °C.
+/// Quartz in the papers' water (§4.2).
 fn material() -> Material {
-    Material { fluid_density: WATER_20C.density, ..Material::default() }
+    Material::default()
 }
 
 /// Diameters (m) whose terminal Reynolds numbers span 0.1 (50 µm) to 1.2 × 10⁴ (13 mm).
@@ -29,7 +29,7 @@ fn drops() -> &'static [(f64, Settling)] {
                 let run = Drop {
                     shape: Shape::Sphere { radius: d / 2.0 },
                     material: material(),
-                    viscosity: WATER_20C.viscosity,
+                    viscosity: WATER.viscosity,
                     orientation: UnitQuaternion::identity(),
                 };
                 (d, drop(&run).expect("a lone sphere settles"))
@@ -45,7 +45,7 @@ fn a_sphere_settles_at_the_closed_form_terminal_velocity_of_its_drag_law() {
     // stopping rule (speed steady to 1e-5 over 5 relaxation times) separates them; 1 % is the
     // issue's bound.
     for (d, s) in drops() {
-        let exact = sphere_terminal_velocity(&WATER_20C, 2650.0, 9.81, *d);
+        let exact = sphere_terminal_velocity(&WATER, 2650.0, 9.81, *d);
         let error = s.terminal_velocity / exact - 1.0;
         assert!(error.abs() < 0.01, "d = {d} m: {} m/s against {exact} m/s", s.terminal_velocity);
         assert!(s.drift < 1e-12 * exact, "a sphere falls straight: {}", s.drift);
@@ -85,7 +85,7 @@ fn against_the_standard_drag_curve_a_sphere_under_the_papers_law_settles_up_to_1
     // 2240, 0.95 at 1.0 × 10⁴). The check pins that envelope: within 2 % for Re_p ≤ 0.2, between
     // 0.85 and 1 up to 1.2 × 10⁴.
     for (d, s) in drops() {
-        let standard = standard_velocity(&WATER_20C, *d);
+        let standard = standard_velocity(&WATER, *d);
         let ratio = s.terminal_velocity / standard;
         let lowest = if s.reynolds <= 0.2 { 0.98 } else { 0.85 };
         assert!(ratio <= 1.0 && ratio > lowest, "d = {d} m, Re_p {}: {ratio}", s.reynolds);
@@ -100,7 +100,7 @@ fn a_sphere_starting_at_rest_approaches_its_terminal_velocity_as_stokes_drag_say
     // exponential (it is largest, ~0.8 %, while the grain accelerates); 1 % is the check.
     let d = 2e-5;
     let m = material();
-    let exact = sphere_terminal_velocity(&WATER_20C, m.density, 9.81, d);
+    let exact = sphere_terminal_velocity(&WATER, m.density, 9.81, d);
     let tau = exact / (9.81 * (1.0 - m.fluid_density / m.density));
     let time_step = tau / 400.0;
     let settings = Settings { material: m, time_step, skin: 1e-6, calibration: Calibration::Discrete };
@@ -113,7 +113,7 @@ fn a_sphere_starting_at_rest_approaches_its_terminal_velocity_as_stokes_drag_say
         angular_velocity: Vector3::zeros(),
     });
     sim.fluid = Some(Fluid {
-        viscosity: WATER_20C.viscosity,
+        viscosity: WATER.viscosity,
         flow: Flow::Quiescent,
         lift: true,
         cell: 1e-3,
@@ -148,19 +148,19 @@ fn a_sphere_at_rest_over_the_bed_of_a_sheared_flow_is_lifted_by_eq_8() {
         velocity: Vector3::zeros(),
         angular_velocity: Vector3::zeros(),
     });
-    sim.fluid = Some(Fluid { viscosity: WATER_20C.viscosity, flow, lift: true, cell: 0.01, slice: 1e-3, cutoff: 0.5 });
+    sim.fluid = Some(Fluid { viscosity: WATER.viscosity, flow, lift: true, cell: 0.01, slice: 1e-3, cutoff: 0.5 });
     sim.step().unwrap();
-    let nu = WATER_20C.viscosity / WATER_20C.density;
+    let nu = WATER.viscosity / WATER.density;
     let rate = 0.01f64.powi(2) / nu;
     let (u, g) = (rate * (z - z * z / 0.1), rate * (1.0 - z / 0.05));
     let volume = std::f64::consts::PI * d.powi(3) / 6.0;
     let mass = m.density * volume;
     let lift = sim.bodies.velocity[0].z * mass / 5e-6 + (m.density - m.fluid_density) * volume * 9.81;
-    let saffman = 1.6 * WATER_20C.density * nu.sqrt() * d * d * u * g.sqrt();
+    let saffman = 1.6 * WATER.density * nu.sqrt() * d * d * u * g.sqrt();
     assert!((lift / saffman - 1.0).abs() < 1e-6, "lift {lift} N against {saffman} N");
     assert!(saffman > 0.0, "a grain lagging the flow is lifted");
     // Drag along the flow: Eqs. 3–7 for a sphere alone at slip U.
-    let re = WATER_20C.density * d * u / WATER_20C.viscosity;
-    let drag = (0.63 + 4.8 / re.sqrt()).powi(2) * 0.5 * WATER_20C.density * u * u * std::f64::consts::PI * d * d / 4.0;
+    let re = WATER.density * d * u / WATER.viscosity;
+    let drag = (0.63 + 4.8 / re.sqrt()).powi(2) * 0.5 * WATER.density * u * u * std::f64::consts::PI * d * d / 4.0;
     assert!((sim.bodies.velocity[0].x * mass / 5e-6 / drag - 1.0).abs() < 1e-9);
 }

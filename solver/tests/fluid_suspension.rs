@@ -8,14 +8,14 @@ use rand_chacha::ChaCha8Rng;
 use solver::dem::{Calibration, Domain, Material, NewBody, Settings, Shape, Simulation};
 use solver::fluid::flow::Flow;
 use solver::fluid::settling::{richardson_zaki_exponent, sphere_terminal_velocity};
-use solver::fluid::{Fluid, WATER_20C};
+use solver::fluid::{Fluid, WATER};
 
 /// Mean vertical velocity of the spheres in the middle of a cloud at solid fraction `phi`,
 /// after 8 relaxation times, over u_t ε^n; and the terminal Reynolds number of one sphere.
 fn hindered(d: f64, phi: f64, spheres: usize, time_step: f64) -> (f64, f64) {
-    let m = Material { fluid_density: WATER_20C.density, ..Material::default() };
-    let alone = sphere_terminal_velocity(&WATER_20C, m.density, 9.81, d);
-    let reynolds = WATER_20C.reynolds(d, alone);
+    let m = Material::default();
+    let alone = sphere_terminal_velocity(&WATER, m.density, 9.81, d);
+    let reynolds = WATER.reynolds(d, alone);
     let tau = alone / (9.81 * (1.0 - m.fluid_density / m.density));
     let width = 8.0 * d;
     // The cloud: `spheres` spheres at random, none overlapping, in a layer whose height gives
@@ -52,7 +52,7 @@ fn hindered(d: f64, phi: f64, spheres: usize, time_step: f64) -> (f64, f64) {
         });
     }
     sim.fluid = Some(Fluid {
-        viscosity: WATER_20C.viscosity,
+        viscosity: WATER.viscosity,
         flow: Flow::Quiescent,
         lift: true,
         cell: 3.0 * d,

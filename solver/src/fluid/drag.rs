@@ -122,8 +122,13 @@ impl SyamlalOBrien {
 /// V_r of Eqs. 6–7 for fluid fraction `fluid_fraction` and particle Reynolds number `reynolds`.
 #[inline]
 pub fn velocity_ratio(fluid_fraction: f64, reynolds: f64) -> f64 {
-    let a1 = fluid_fraction.powf(4.14);
-    let a2 = if fluid_fraction <= 0.85 { 0.8 * fluid_fraction.powf(1.28) } else { fluid_fraction.powf(2.65) };
+    // Alone (A₁ = A₂ = 1) the ratio is 1: 0.5 (1 − r + √((1 + r)²)).
+    if fluid_fraction >= 1.0 {
+        return 1.0;
+    }
+    let ln = fluid_fraction.ln();
+    let a1 = (4.14 * ln).exp();
+    let a2 = if fluid_fraction <= 0.85 { 0.8 * (1.28 * ln).exp() } else { (2.65 * ln).exp() };
     let r = 0.06 * reynolds;
     0.5 * (a1 - r + (r * r + 2.0 * r * (2.0 * a2 - a1) + a1 * a1).sqrt())
 }

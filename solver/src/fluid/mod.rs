@@ -32,12 +32,14 @@ use self::drag::{FluidProperties, HaiderLevenspiel, SyamlalOBrien};
 use self::flow::Flow;
 use self::fraction::{FractionGrid, Stencil};
 use self::lift::SaffmanLift;
-use self::shielding::{WetSphere, shelter};
+use self::shielding::Wake;
 use crate::dem::{Bodies, Domain, Shape};
 use crate::porosity;
 
-/// Water at 20 °C: density (kg/m³) and dynamic viscosity (Pa·s), IAPWS values.
-pub const WATER_20C: FluidProperties = FluidProperties { density: 998.21, viscosity: 1.0016e-3 };
+/// The papers' water: density 1000 kg/m³ (the first paper's §4.2, the second's Table 1) and the
+/// dynamic viscosity of water at 20 °C, 1.0016 mPa·s (IAPWS; the second paper's ν = 1.0e-6
+/// m²/s rounds it). Water at 20 °C is 998.21 kg/m³, 0.18 % lighter.
+pub const WATER: FluidProperties = FluidProperties { density: 1000.0, viscosity: 1.0016e-3 };
 
 /// The fluid forces of a simulation: the fluid's viscosity (its density is the material's
 /// `fluid_density`, the same as buoyancy's), the prescribed flow and the averaging.
@@ -63,10 +65,23 @@ pub struct FluidLoad {
     pub torque: Vector3<f64>,
 }
 
+/// A sphere of a body as the fluid sees it: the body itself as its sphere of equal volume, or
+/// one component sphere of a bonded grain.
+#[derive(Debug, Clone, Copy)]
+struct Wet {
+    center: Vector3<f64>,
+    radius: f64,
+    volume: f64,
+    stencil: Stencil,
+}
+
 /// The fluid stage's working memory, owned by the step pipeline: filled afresh every step.
 #[derive(Debug, Clone, Default)]
 pub struct Scratch {
     grid: FractionGrid,
+    /// The spheres of every body, body k's at `wet[first[k]..first[k + 1]]`.
+    wet: Vec<Wet>,
+    first: Vec<usize>,
     /// Per body: diameter of the sphere of equal volume and, for a body that is not made of
     /// spheres, its drag curve (shapes never change, so this is computed once per body).
     drag_shape: Vec<(f64, Option<HaiderLevenspiel>)>,
@@ -93,20 +108,26 @@ impl Fluid {
 
         let top = (0..n).map(|k| bodies.position[k].z + bodies.bounding_radius[k]).fold(0.0, f64::max);
         scratch.grid.reset(domain, self.cell, top);
+        scratch.wet.clear();
+        scratch.first.clear();
         for k in 0..n {
-            for (center, _, volume) in pieces(&bodies.shape[k], &bodies.position[k], &bodies.orientation[k]) {
+            scratch.first.push(scratch.wet.len());
+            for (center, radius, volume) in pieces(&bodies.shape[k], &bodies.position[k], &bodies.orientation[k]) {
                 let stencil = scratch.grid.stencil(&center);
                 scratch.grid.deposit(&stencil, volume);
+                scratch.wet.push(Wet { center, radius, volume, stencil });
             }
         }
+        scratch.first.push(scratch.wet.len());
         scratch.bed = if self.flow.needs_bed() { self.bed_surface(bodies, domain, &mut scratch.spheres) } else { 0.0 };
 
-        let (grid, drag_shape, bed) = (&scratch.grid, &scratch.drag_shape, scratch.bed);
-        scratch.loads.resize(n, FluidLoad::default());
-        scratch.loads.par_iter_mut().enumerate().for_each_init(Default::default, |wet, (k, load)| {
+        let Scratch { grid, drag_shape, bed, wet, first, loads, .. } = scratch;
+        loads.resize(n, FluidLoad::default());
+        loads.par_iter_mut().enumerate().for_each(|(k, load)| {
+            let wet = &wet[first[k]..first[k + 1]];
             *load = match drag_shape[k] {
-                (diameter, Some(curve)) => self.single_body(bodies, k, diameter, curve, grid, bed, &fluid),
-                (_, None) => self.spheres(bodies, k, grid, bed, &fluid, wet),
+                (diameter, Some(curve)) => self.single_body(bodies, k, diameter, curve, &wet[0], grid, *bed, &fluid),
+                (_, None) => self.spheres(bodies, k, wet, grid, *bed, &fluid),
             };
         });
     }
@@ -119,14 +140,14 @@ impl Fluid {
         k: usize,
         diameter: f64,
         curve: HaiderLevenspiel,
+        wet: &Wet,
         grid: &FractionGrid,
         bed: f64,
         fluid: &FluidProperties,
     ) -> FluidLoad {
         let x = bodies.position[k];
         let volume = bodies.volume[k];
-        let stencil = grid.stencil(&x);
-        let fraction = grid.fluid_fraction(&stencil, volume * stencil.overlap(&stencil));
+        let fraction = grid.fluid_fraction(&wet.stencil, volume * wet.stencil.overlap(&wet.stencil));
         let (velocity, vorticity) = self.flow.at(&x, bed, fluid.kinematic_viscosity());
         let slip = velocity - bodies.velocity[k];
         let mut force = SyamlalOBrien { curve }.force(fluid, diameter, volume, fraction, &slip);
@@ -141,35 +162,39 @@ impl Fluid {
         &self,
         bodies: &Bodies,
         k: usize,
+        wet: &[Wet],
         grid: &FractionGrid,
         bed: f64,
         fluid: &FluidProperties,
-        (wet, stencils): &mut (Vec<WetSphere>, Vec<Stencil>),
     ) -> FluidLoad {
         let x = bodies.position[k];
         let nu = fluid.kinematic_viscosity();
-        wet.clear();
-        stencils.clear();
-        for (center, radius, _) in pieces(&bodies.shape[k], &x, &bodies.orientation[k]) {
-            let (velocity, _) = self.flow.at(&center, bed, nu);
-            let slip = velocity - bodies.point_velocity(k, &(center - x));
-            wet.push(WetSphere { center, radius, slip });
-            stencils.push(grid.stencil(&center));
-        }
-        shelter(wet, nu);
+        // Fluid velocity minus the grain's velocity at a sphere's centre, and the vorticity there.
+        let seen = |w: &Wet| {
+            let (velocity, vorticity) = self.flow.at(&w.center, bed, nu);
+            (velocity - bodies.point_velocity(k, &(w.center - x)), vorticity)
+        };
+        let wake = (wet.len() > 1)
+            .then(|| {
+                let mean = wet.iter().map(|w| seen(w).0 * w.volume).sum::<Vector3<f64>>() / bodies.volume[k];
+                Wake::new(&mean, nu)
+            })
+            .flatten();
         let mut load = FluidLoad::default();
-        for (sphere, stencil) in wet.iter().zip(stencils.iter()) {
-            let own: f64 =
-                wet.iter().zip(stencils.iter()).map(|(s, t)| ball_volume(s.radius) * t.overlap(stencil)).sum();
-            let fraction = grid.fluid_fraction(stencil, own);
-            let d = 2.0 * sphere.radius;
-            let mut f = SyamlalOBrien::SPHERES.force(fluid, d, ball_volume(sphere.radius), fraction, &sphere.slip);
+        for w in wet {
+            let (mut slip, vorticity) = seen(w);
+            if let Some(wake) = &wake {
+                slip *= wake.shelter(&w.center, w.radius, wet.iter().map(|v| (v.center, v.radius)));
+            }
+            let own: f64 = wet.iter().map(|v| v.volume * v.stencil.overlap(&w.stencil)).sum();
+            let fraction = grid.fluid_fraction(&w.stencil, own);
+            let d = 2.0 * w.radius;
+            let mut f = SyamlalOBrien::SPHERES.force(fluid, d, w.volume, fraction, &slip);
             if self.lift {
-                let (_, vorticity) = self.flow.at(&sphere.center, bed, nu);
-                f += SaffmanLift::PAPER.force(fluid, d, &sphere.slip, &vorticity);
+                f += SaffmanLift::PAPER.force(fluid, d, &slip, &vorticity);
             }
             load.force += f;
-            load.torque += (sphere.center - x).cross(&f);
+            load.torque += (w.center - x).cross(&f);
         }
         load
     }
@@ -198,8 +223,4 @@ fn pieces<'a>(
     };
     let whole = bonded.is_empty().then(|| (*x, shape.equivalent_radius(), shape.volume()));
     whole.into_iter().chain(bonded.iter().map(move |c| (x + q * c.center, c.radius, c.volume())))
-}
-
-fn ball_volume(radius: f64) -> f64 {
-    4.0 / 3.0 * std::f64::consts::PI * radius.powi(3)
 }

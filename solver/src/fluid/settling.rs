@@ -87,6 +87,13 @@ pub fn sphere_terminal_velocity(fluid: &FluidProperties, grain_density: f64, gra
     DallaValle::terminal_reynolds(archimedes) * fluid.viscosity / (fluid.density * d)
 }
 
+/// The orientation `sedpack settle` releases a grain in: turned 40° about its long axis, then
+/// 25° about a horizontal axis, so that a grain that turns while settling shows it.
+pub fn release_orientation() -> UnitQuaternion<f64> {
+    UnitQuaternion::from_axis_angle(&Vector3::y_axis(), 25f64.to_radians())
+        * UnitQuaternion::from_axis_angle(&Vector3::x_axis(), 40f64.to_radians())
+}
+
 /// One grain dropped in still water: the run's settings.
 #[derive(Debug, Clone)]
 pub struct Drop {

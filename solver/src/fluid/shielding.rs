@@ -32,15 +32,6 @@ use nalgebra::Vector3;
 
 use super::drag::{DallaValle, DragCurve};
 
-/// One component sphere of a grain as the fluid sees it.
-#[derive(Debug, Clone, Copy)]
-pub struct WetSphere {
-    pub center: Vector3<f64>,
-    pub radius: f64,
-    /// Fluid velocity minus the sphere's velocity at its centre.
-    pub slip: Vector3<f64>,
-}
-
 /// Area of the intersection of two disks of radii `a` and `b` whose centres are `d` apart.
 pub fn lens_area(a: f64, b: f64, d: f64) -> f64 {
     if d >= a + b {
@@ -50,44 +41,61 @@ pub fn lens_area(a: f64, b: f64, d: f64) -> f64 {
     if d <= (a - b).abs() {
         return PI * small * small;
     }
-    let alpha = ((d * d + a * a - b * b) / (2.0 * d * a)).clamp(-1.0, 1.0).acos();
-    let beta = ((d * d + b * b - a * a) / (2.0 * d * b)).clamp(-1.0, 1.0).acos();
-    a * a * (alpha - alpha.sin() * alpha.cos()) + b * b * (beta - beta.sin() * beta.cos())
+    // Each disk contributes the segment cut off by the chord: r² (θ − sin θ cos θ) with cos θ
+    // from the triangle of the two centres and a crossing point.
+    let segment = |r: f64, c: f64| {
+        let c = c.clamp(-1.0, 1.0);
+        r * r * (c.acos() - c * (1.0 - c * c).sqrt())
+    };
+    segment(a, (d * d + a * a - b * b) / (2.0 * d * a)) + segment(b, (d * d + b * b - a * a) / (2.0 * d * b))
 }
 
-/// Reduces each sphere's slip by the wakes of the grain's spheres upstream of it (module doc).
-/// The flow direction and speed are those of the grain's volume-weighted mean slip, taken
-/// before any sphere is sheltered.
-pub fn shelter(spheres: &mut [WetSphere], kinematic_viscosity: f64) {
-    if spheres.len() < 2 {
-        return;
+/// The flow past a grain: direction and speed of its volume-weighted mean slip.
+#[derive(Debug, Clone, Copy)]
+pub struct Wake {
+    along: Vector3<f64>,
+    speed: f64,
+    kinematic_viscosity: f64,
+}
+
+impl Wake {
+    /// The wakes of a grain whose spheres slip past the fluid at `mean_slip` on average; None
+    /// for a grain at rest in the fluid.
+    pub fn new(mean_slip: &Vector3<f64>, kinematic_viscosity: f64) -> Option<Self> {
+        let speed = mean_slip.norm();
+        (speed > 0.0).then(|| Self { along: mean_slip / speed, speed, kinematic_viscosity })
     }
-    let mean: Vector3<f64> = spheres.iter().map(|s| s.slip * s.radius.powi(3)).sum();
-    let speed = mean.norm() / spheres.iter().map(|s| s.radius.powi(3)).sum::<f64>();
-    if speed == 0.0 {
-        return;
-    }
-    let along = mean.normalize();
-    for j in 0..spheres.len() {
-        let (center, radius) = (spheres[j].center, spheres[j].radius);
-        let factor: f64 = spheres
-            .iter()
-            .filter_map(|i| {
-                let offset = center - i.center;
-                let x = offset.dot(&along);
-                if x <= 0.0 {
-                    return None;
-                }
-                let lateral = (offset - x * along).norm();
-                let wake2 = i.radius * i.radius + 4.0 * kinematic_viscosity * x / speed;
-                let reynolds = 2.0 * i.radius * speed / kinematic_viscosity;
-                let deficit = (0.5 * DallaValle.drag_coefficient(reynolds) * i.radius * i.radius / wake2).min(1.0);
-                let covered = lens_area(radius, wake2.sqrt(), lateral) / (PI * radius * radius);
-                let behind = 1.0 - (-speed * x / kinematic_viscosity).exp();
-                Some(1.0 - deficit * covered * behind)
-            })
-            .product();
-        spheres[j].slip *= factor;
+
+    /// The share of its slip that a sphere (`center`, `radius`) keeps behind the grain's
+    /// spheres `spheres` (centre, radius; itself among them is skipped, being level with
+    /// itself): the product over the spheres upstream of 1 − deficit × covered × behind.
+    pub fn shelter(
+        &self,
+        center: &Vector3<f64>,
+        radius: f64,
+        spheres: impl Iterator<Item = (Vector3<f64>, f64)>,
+    ) -> f64 {
+        let nu = self.kinematic_viscosity;
+        let mut factor = 1.0;
+        for (upstream, r) in spheres {
+            let offset = center - upstream;
+            let x = offset.dot(&self.along);
+            if x <= 0.0 {
+                continue;
+            }
+            let lateral2 = (offset.norm_squared() - x * x).max(0.0);
+            let wake2 = r * r + 4.0 * nu * x / self.speed;
+            // Disks of radii r_j and R overlap only closer than r_j + R.
+            if lateral2 >= radius * radius + wake2 + 2.0 * radius * wake2.sqrt() {
+                continue;
+            }
+            let reynolds = 2.0 * r * self.speed / nu;
+            let deficit = (0.5 * DallaValle.drag_coefficient(reynolds) * r * r / wake2).min(1.0);
+            let covered = lens_area(radius, wake2.sqrt(), lateral2.sqrt()) / (PI * radius * radius);
+            let behind = 1.0 - (-self.speed * x / nu).exp();
+            factor *= 1.0 - deficit * covered * behind;
+        }
+        factor
     }
 }
 
@@ -103,9 +111,12 @@ mod tests {
         assert!((lens_area(1.0, 1.0, 1.0) - (2.0 * PI / 3.0 - 3f64.sqrt() / 2.0)).abs() < 1e-12);
     }
 
-    fn pair(offset: Vector3<f64>, speed: f64) -> [WetSphere; 2] {
-        let slip = Vector3::new(0.0, 0.0, speed);
-        [WetSphere { center: Vector3::zeros(), radius: 1e-3, slip }, WetSphere { center: offset, radius: 1e-3, slip }]
+    /// The shelter factors of two 1 mm spheres, the second at `offset`, slipping together at
+    /// `speed` up the z axis.
+    fn pair(offset: Vector3<f64>, speed: f64) -> [f64; 2] {
+        let wake = Wake::new(&Vector3::new(0.0, 0.0, speed), 1e-6).unwrap();
+        let spheres = [(Vector3::zeros(), 1e-3), (offset, 1e-3)];
+        spheres.map(|(c, r)| wake.shelter(&c, r, spheres.iter().copied()))
     }
 
     #[test]
@@ -114,22 +125,19 @@ mod tests {
         // Re = 200, C_D = (0.63 + 4.8/√200)² = 0.9395; touching, x = d: R² = r² + 4ν d/|w| = 1.08 r²
         // and the wake weight is 1 − e^(−200) = 1, so the upper sphere keeps 1 − (0.9395/2)/1.08
         // of its slip.
-        let mut line = pair(Vector3::new(0.0, 0.0, 2e-3), 0.1);
-        shelter(&mut line, 1e-6);
+        let line = pair(Vector3::new(0.0, 0.0, 2e-3), 0.1);
         let cd = (0.63 + 4.8 / 200f64.sqrt()).powi(2);
-        assert_eq!(line[0].slip.z, 0.1);
-        assert!((line[1].slip.z / 0.1 - (1.0 - cd / 2.0 / 1.08)).abs() < 1e-12, "{}", line[1].slip.z);
+        assert_eq!(line[0], 1.0);
+        assert!((line[1] - (1.0 - cd / 2.0 / 1.08)).abs() < 1e-12, "{}", line[1]);
         // Side by side across the flow: nobody is in anybody's wake.
-        let mut across = pair(Vector3::new(2e-3, 0.0, 0.0), 0.1);
-        shelter(&mut across, 1e-6);
-        assert_eq!((across[0].slip.z, across[1].slip.z), (0.1, 0.1));
+        assert_eq!(pair(Vector3::new(2e-3, 0.0, 0.0), 0.1), [1.0, 1.0]);
+        assert_eq!(Wake::new(&Vector3::zeros(), 1e-6).map(|_| ()), None);
     }
 
     #[test]
     fn the_shelter_fades_in_creeping_flow() {
         // |w| x/ν = 0.002 (Re = 0.002): the wake weight 1 − e^(−0.002) leaves 0.2 % of a deficit.
-        let mut slow = pair(Vector3::new(0.0, 0.0, 2e-3), 1e-6);
-        shelter(&mut slow, 1e-6);
-        assert!(1.0 - slow[1].slip.z / 1e-6 < 0.002 + 1e-12, "{}", slow[1].slip.z);
+        let slow = pair(Vector3::new(0.0, 0.0, 2e-3), 1e-6);
+        assert!(1.0 - slow[1] < 0.002 + 1e-12, "{}", slow[1]);
     }
 }
