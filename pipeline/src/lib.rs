@@ -32,5 +32,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Export(args) => commands::campaign::export(&args),
         Command::Report(args) => commands::report::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
+        Command::Settle(args) => commands::settle::run(&args),
     }
 }

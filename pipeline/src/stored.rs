@@ -4,18 +4,27 @@
 //! applied), so a job runs the same whatever later versions take as defaults.
 //!
 //! Format 1 is the JSON of sedpack 0.1.0, byte for byte. A new format gets a new number (the
-//! `format` column of the jobs table) and its own types beside these.
+//! `format` column of the jobs table) and its own types beside these. Format 2 is format 1 with
+//! fluid forces (`packing.fluid`), which format 1 has not: a job without them is written in
+//! format 1, the same bytes and id as before, and a version that knows only format 1 refuses a
+//! job with them instead of running it without.
 
 use anyhow::{Context, bail};
 use nalgebra::Vector3;
 use solver::dem::{Calibration, Domain, Material, Shaking};
+use solver::fluid::flow::Flow;
 use solver::grain::{FormDistribution, MeshLibrary, SieveCurve, Table3Case};
-use solver::packing::{FormSpec, GrainSpec, PackingSpec, Process, ShapeKind};
+use solver::packing::{FluidSpec, FormSpec, GrainSpec, PackingSpec, Process, ShapeKind};
 
 use crate::spec::JobSpec;
 
-/// The format this version writes.
-pub const FORMAT: u32 = 1;
+/// The newest format this version reads and writes.
+pub const FORMAT: u32 = 2;
+
+/// The format a job is written in: the oldest that holds it.
+pub fn format(job: &JobSpec) -> u32 {
+    if job.packing.fluid.is_some() { 2 } else { 1 }
+}
 
 /// Format 1, the JSON of sedpack 0.1.0.
 mod v1 {
@@ -43,6 +52,25 @@ mod v1 {
         pub(super) cutoff: f64,
         pub(super) trim: Option<f64>,
         pub(super) seed: u64,
+        /// Format 2 only; absent, it leaves format 1's bytes as they were.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub(super) fluid: Option<Fluid>,
+    }
+
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    pub(super) struct Fluid {
+        pub(super) viscosity: f64,
+        pub(super) flow: Flow,
+        pub(super) lift: bool,
+        pub(super) cell: f64,
+    }
+
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    pub(super) enum Flow {
+        Quiescent,
+        Uniform { velocity: [f64; 3] },
+        Laminar { shear_velocity: f64, depth: f64 },
+        Logarithmic { shear_velocity: f64, roughness: f64 },
     }
 
     #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -140,7 +168,7 @@ mod v1 {
     }
 }
 
-/// The stored JSON of a job, in format [`FORMAT`].
+/// The stored JSON of a job, in its [`format`].
 pub fn encode(job: &JobSpec) -> serde_json::Value {
     serde_json::to_value(stored(job)).expect("the stored job is plain numbers, strings and lists")
 }
@@ -153,11 +181,15 @@ pub fn canonical_json(job: &JobSpec) -> String {
 /// The job a stored JSON of the given format describes. Its meshes, if any, are only named: the
 /// caller loads them again.
 pub fn decode(format: u32, json: &serde_json::Value) -> anyhow::Result<JobSpec> {
-    if format != FORMAT {
-        bail!("the job is stored in format {format}, which this version of sedpack (format {FORMAT}) cannot read");
+    if !(1..=FORMAT).contains(&format) {
+        bail!("the job is stored in format {format}, which this version of sedpack (formats 1–{FORMAT}) cannot read");
     }
-    let job: v1::Job = serde_json::from_value(json.clone()).context("the stored job is not format 1")?;
+    let job: v1::Job =
+        serde_json::from_value(json.clone()).with_context(|| format!("the stored job is not format {format}"))?;
     let p = job.packing;
+    if p.fluid.is_some() != (format == 2) {
+        bail!("the stored job is not format {format}: format 2 is the one with fluid forces");
+    }
     let time_step = p.time_step;
     let calibration = match p.calibration {
         v1::Calibration::Continuous => Calibration::Continuous,
@@ -233,6 +265,17 @@ pub fn decode(format: u32, json: &serde_json::Value) -> anyhow::Result<JobSpec> 
         cutoff: p.cutoff,
         trim: p.trim,
         seed: p.seed,
+        fluid: p.fluid.map(|f| FluidSpec {
+            viscosity: f.viscosity,
+            flow: match f.flow {
+                v1::Flow::Quiescent => Flow::Quiescent,
+                v1::Flow::Uniform { velocity } => Flow::Uniform { velocity: Vector3::from(velocity) },
+                v1::Flow::Laminar { shear_velocity, depth } => Flow::Laminar { shear_velocity, depth },
+                v1::Flow::Logarithmic { shear_velocity, roughness } => Flow::Logarithmic { shear_velocity, roughness },
+            },
+            lift: f.lift,
+            cell: Some(f.cell),
+        }),
     };
     packing.check().context("the stored job")?;
     let experiment = job.experiment.map(|e| analysis::Experiment { porosity: e.porosity, std: e.std });
@@ -307,6 +350,19 @@ fn stored(job: &JobSpec) -> v1::Job {
             cutoff: spec.cutoff,
             trim: spec.trim,
             seed: spec.seed,
+            fluid: spec.fluid.map(|f| v1::Fluid {
+                viscosity: f.viscosity,
+                flow: match f.flow {
+                    Flow::Quiescent => v1::Flow::Quiescent,
+                    Flow::Uniform { velocity } => v1::Flow::Uniform { velocity: velocity.into() },
+                    Flow::Laminar { shear_velocity, depth } => v1::Flow::Laminar { shear_velocity, depth },
+                    Flow::Logarithmic { shear_velocity, roughness } => {
+                        v1::Flow::Logarithmic { shear_velocity, roughness }
+                    }
+                },
+                lift: f.lift,
+                cell: derived.fluid_cell,
+            }),
         },
         experiment: job.experiment.map(|e| v1::Experiment { porosity: e.porosity, std: e.std }),
     }
@@ -329,7 +385,7 @@ mod tests {
         cylinder.trim = Some(0.002);
         for spec in [PackingSpec::paper(DomainKind::Periodic), cylinder] {
             let original = job(spec);
-            let back = decode(FORMAT, &encode(&original)).unwrap();
+            let back = decode(format(&original), &encode(&original)).unwrap();
             assert_eq!(back.packing.derived(), original.packing.derived());
             assert_eq!(back.packing.height, Some(original.packing.derived().height));
             assert_eq!((back.name.as_str(), back.experiment), ("j", original.experiment));
@@ -338,17 +394,39 @@ mod tests {
     }
 
     #[test]
+    fn a_job_with_fluid_forces_is_format_2_and_reads_back_with_its_cell_concrete() {
+        let mut spec = PackingSpec::paper(DomainKind::Periodic);
+        spec.fluid = Some(FluidSpec {
+            flow: Flow::Logarithmic { shear_velocity: 0.05, roughness: 2e-4 },
+            ..FluidSpec::STILL_WATER
+        });
+        let original = job(spec);
+        assert_eq!(format(&original), 2);
+        let stored = encode(&original);
+        assert_eq!(stored["packing"]["fluid"]["cell"], serde_json::json!(original.packing.derived().fluid_cell));
+        let back = decode(2, &stored).unwrap();
+        assert_eq!(back.packing.fluid.map(|f| f.flow), original.packing.fluid.map(|f| f.flow));
+        assert_eq!(canonical_json(&back), canonical_json(&original));
+        let error = decode(1, &stored).unwrap_err().to_string();
+        assert!(error.contains("format 2 is the one with fluid forces"), "{error}");
+        // Without fluid forces the stored JSON has no `fluid` key: format 1's bytes.
+        assert!(encode(&job(PackingSpec::paper(DomainKind::Periodic)))["packing"].get("fluid").is_none());
+    }
+
+    #[test]
     fn stored_jobs_that_disagree_with_themselves_or_another_format_are_refused() {
         let stored = encode(&job(PackingSpec::paper(DomainKind::Periodic)));
+        let error = decode(3, &stored).unwrap_err().to_string();
+        assert!(error.contains("format 3"), "{error}");
         let error = decode(2, &stored).unwrap_err().to_string();
-        assert!(error.contains("format 2"), "{error}");
+        assert!(error.contains("fluid forces"), "{error}");
         let mut two_steps = stored.clone();
         two_steps["packing"]["calibration"]["Discrete"]["time_step"] = serde_json::json!(1e-5);
-        let error = decode(FORMAT, &two_steps).unwrap_err().to_string();
+        let error = decode(1, &two_steps).unwrap_err().to_string();
         assert!(error.contains("1e-5") || error.contains("0.00001"), "{error}");
         let mut renamed = stored;
         renamed["size_case"] = serde_json::json!("U7");
-        let error = decode(FORMAT, &renamed).unwrap_err().to_string();
+        let error = decode(1, &renamed).unwrap_err().to_string();
         assert!(error.contains("size case U7"), "{error}");
     }
 }
