@@ -1,4 +1,4 @@
-//! Cost of the ellipsoid narrow phase (issue 3, item 3: ≤ 1 µs per persisting contact).
+//! Cost of the ellipsoid narrow phase per persisting contact.
 //!
 //! Each benchmark runs over a fixed set of 1024 random pairs (semi-axes in [1, 10], so aspect
 //! ratios up to 10:1, random orientations): criterion's time is per 1024 queries, its

@@ -1,4 +1,4 @@
-//! Cost of the convex-polyhedron narrow phase (issue 4: contact queries per second for polyhedra
+//! Cost of the convex-polyhedron narrow phase (contact queries per second for polyhedra
 //! of ~50, 100 and 300 faces, warm and cold), next to parry3d's GJK/EPA on the same pairs.
 //!
 //! The grains are generated pebbles (1000 faces) simplified to at most 50, 100 and 300 faces
@@ -6,7 +6,8 @@
 //! 1024 random pairs in shallow contact, as in a settled packing: B approaches A along a random
 //! direction until they touch and then 0.1 % of the grain size further. "warm" is the same pair
 //! one time step later (both turned by 1e-4 rad, B moved by 1e-6) with the previous normal
-//! passed in; "cold" has no previous normal. Criterion's time is per 1024 queries, its
+//! passed in; "cold" has no previous normal; "engine, kept features" is the simulation's query
+//! with what it kept of the previous step's contact. Criterion's time is per 1024 queries, its
 //! throughput in queries per second. Mean GJK and EPA iterations go to stderr.
 
 mod common;
@@ -19,8 +20,10 @@ use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use parry3d_f64::math::{Pose, Rotation as PRotation, Vector as PVector};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use solver::dem::contact::coherence::Features;
 use solver::dem::contact::polyhedron::{
-    PolyhedronPose, polyhedron_plane, polyhedron_polyhedron, polyhedron_polyhedron_with_stats,
+    Mode, PolyhedronPose, polyhedron_plane, polyhedron_polyhedron, polyhedron_polyhedron_coherent,
+    polyhedron_polyhedron_with_stats,
 };
 use solver::dem::shape::ConvexPolyhedron;
 use solver::dem::uniform_rotation;
@@ -64,6 +67,8 @@ struct Pair {
     qb: UnitQuaternion<f64>,
     xb: V3,
     previous_normal: V3,
+    /// The features the engine kept from the previous step's contact.
+    features: Features,
     /// The rotation matrices of qa and qb.
     ra: Matrix3<f64>,
     rb: Matrix3<f64>,
@@ -108,6 +113,7 @@ fn pairs(g: &Grains) -> Vec<Pair> {
             qb,
             xb: V3::zeros(),
             previous_normal: V3::zeros(),
+            features: Features::default(),
             ra: Matrix3::zeros(),
             rb: Matrix3::zeros(),
         };
@@ -125,8 +131,12 @@ fn pairs(g: &Grains) -> Vec<Pair> {
         }
         pair.xb = m * (outside - 1e-3 * 0.5 * size);
         let (pa, pb) = pair.poses(g);
-        let Some(contact) = polyhedron_polyhedron(&pa, &pb, None) else { continue };
+        let mut features = Features::default();
+        let Some(contact) = polyhedron_polyhedron_coherent(&pa, &pb, None, &mut features, Mode::Coherent).0 else {
+            continue;
+        };
         pair.previous_normal = contact.normal;
+        pair.features = features;
         let qa = UnitQuaternion::from_scaled_axis(random_unit(&mut rng) * 1e-4) * pair.qa;
         let qb = UnitQuaternion::from_scaled_axis(random_unit(&mut rng) * 1e-4) * pair.qb;
         pair.set_rotations(qa, qb);
@@ -178,6 +188,29 @@ fn polyhedron_pairs(c: &mut Criterion) {
                 })
             });
         }
+        // The engine's query one step later: EPA confirmed from the kept features, the centre of
+        // pressure in closed form where it applies.
+        let kept: Vec<(PolyhedronPose, PolyhedronPose, V3, Features)> = pairs
+            .iter()
+            .map(|p| {
+                let (a, b) = p.poses(&g);
+                (a, b, p.previous_normal, p.features)
+            })
+            .collect();
+        group.bench_function("engine, kept features", |bench| {
+            bench.iter(|| {
+                for (a, b, n, f) in &kept {
+                    let mut features = *f;
+                    black_box(polyhedron_polyhedron_coherent(
+                        black_box(a),
+                        black_box(b),
+                        Some(n),
+                        &mut features,
+                        Mode::Coherent,
+                    ));
+                }
+            })
+        });
         let parry_pairs: Vec<(Pose, Pose, usize, usize)> = pairs
             .iter()
             .map(|p| {

@@ -8,7 +8,8 @@
 //!   skin, as LAMMPS does;
 //! * ellipsoids and bonded spheres of the Rhine form distribution (Table 2), polyhedra of the two
 //!   Rhine scans with their own forms (§5.1), all in the 5.6–8 mm sieve class: dropped at 1 m/s
-//!   from a lattice (as the generation of §4.3), poured until every grain has landed (none moves
+//!   (as the generation of §4.3) from a lattice whose layers are spaced for the longest grain
+//!   they hold, in a box 8 to 10 typical grains wide, poured until every grain has landed (none moves
 //!   faster than 0.1 m/s), then damped (Eq. 15) until ⟨z⟩ changes by less than 1e-5 m over 0.01 s (§4.3).
 //!
 //! The material and time step are the paper's (§4.2).
@@ -215,20 +216,45 @@ fn grain_lattice(spec: &BedSpec, rng: &mut ChaCha8Rng) -> Result<Simulation, Sol
             }
         })
         .collect();
-    let reach = shapes.iter().map(Shape::bounding_radius).fold(0.0, f64::max);
-    let spacing = 2.1 * reach;
+    // The box is as wide as 8 to 10 typical grains (each row of sites 2.1 median reaches
+    // apart), or wider if a long grain needs it; each layer of the lattice is spaced for the
+    // longest grain it holds, so a few long grains of the distribution's tail do not spread the
+    // whole bed thin.
+    let mut reaches: Vec<f64> = shapes.iter().map(Shape::bounding_radius).collect();
+    let longest = reaches.iter().cloned().fold(0.0, f64::max);
+    reaches.sort_by(f64::total_cmp);
+    let typical = 2.1 * reaches[reaches.len() / 2];
     let per_row = ((spec.grains as f64 / 30.0).sqrt().round() as usize).max(3);
-    let width = per_row as f64 * spacing;
-    let mut sim = Simulation::new(Domain::Periodic { width }, settings(0.15 * CLASS[0]))?;
-    for (k, shape) in shapes.into_iter().enumerate() {
-        let (i, j, layer) = (k % per_row, k / per_row % per_row, k / (per_row * per_row));
-        let position =
-            Vector3::new((i as f64 + 0.5) * spacing, (j as f64 + 0.5) * spacing, (layer as f64 + 0.5) * spacing);
-        let mut spin = || rng.random_range(-0.1..0.1);
-        let velocity = Vector3::new(spin(), spin(), -1.0);
-        let angular_velocity = Vector3::new(spin(), spin(), spin()) / (2.0 * reach);
-        let orientation = uniform_rotation(rng);
-        sim.add_body(NewBody { shape, position, orientation, velocity, angular_velocity });
+    let skin = 0.15 * CLASS[0];
+    let width = (per_row as f64 * typical).max(2.2 * longest + skin);
+    let mut sim = Simulation::new(Domain::Periodic { width }, settings(skin))?;
+    let mut shapes = shapes.into_iter().peekable();
+    let mut z = 0.0;
+    while shapes.peek().is_some() {
+        // Fill a layer while its sites, spaced for its longest grain, hold all it has taken.
+        let mut layer: Vec<Shape> = Vec::new();
+        let mut spacing = 0.0f64;
+        while let Some(next) = shapes.peek() {
+            let wider = spacing.max(2.1 * next.bounding_radius());
+            let sites = ((width / wider).floor() as usize).max(1).pow(2);
+            if layer.len() >= sites {
+                break;
+            }
+            spacing = wider;
+            layer.push(shapes.next().expect("peeked"));
+        }
+        let row = ((width / spacing).floor() as usize).max(1);
+        z += spacing / 2.0;
+        for (k, shape) in layer.into_iter().enumerate() {
+            let (i, j) = (k % row, k / row);
+            let position = Vector3::new((i as f64 + 0.5) * spacing, (j as f64 + 0.5) * spacing, z);
+            let mut spin = || rng.random_range(-0.1..0.1);
+            let velocity = Vector3::new(spin(), spin(), -1.0);
+            let angular_velocity = Vector3::new(spin(), spin(), spin()) / spacing;
+            let orientation = uniform_rotation(rng);
+            sim.add_body(NewBody { shape, position, orientation, velocity, angular_velocity });
+        }
+        z += spacing / 2.0;
     }
     Ok(sim)
 }

@@ -7,19 +7,10 @@
 
 mod common;
 
-use common::small_bed;
+use common::small_bed_of as spec;
 use solver::dem::Audit;
 use solver::grain::{MeshLibrary, RHINE_FORMS, UnitMesh, rhine_meshes};
 use solver::packing::{FormSpec, Packing, PackingSpec, Phase, ShapeKind};
-
-fn spec(shape: ShapeKind, form: FormSpec, meshes: Option<MeshLibrary>, mass: f64) -> PackingSpec {
-    let mut spec = small_bed(shape, mass, 0.012, 0.05);
-    spec.grains.form = form;
-    spec.grains.meshes = meshes;
-    spec.trim = Some(4e-3);
-    spec.seed = 3;
-    spec
-}
 
 /// Audits every other step until the packing converges; the audit of each phase.
 fn audited(spec: PackingSpec) -> Vec<(Phase, Audit)> {

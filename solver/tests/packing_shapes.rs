@@ -3,19 +3,10 @@
 
 mod common;
 
-use common::small_bed;
+use common::small_bed_of as spec;
 use solver::dem::Shape;
 use solver::grain::{MeshLibrary, RHINE_FORMS, UnitMesh, rhine_meshes};
-use solver::packing::{FormSpec, Packing, PackingSpec, Phase, ShapeKind};
-
-fn spec(shape: ShapeKind, form: FormSpec, meshes: Option<MeshLibrary>, mass: f64) -> PackingSpec {
-    let mut spec = small_bed(shape, mass, 0.012, 0.05);
-    spec.grains.form = form;
-    spec.grains.meshes = meshes;
-    spec.trim = Some(4e-3);
-    spec.seed = 3;
-    spec
-}
+use solver::packing::{FormSpec, Packing, Phase, ShapeKind};
 
 fn converge(packing: &mut Packing) -> f64 {
     while packing.advance(20_000).unwrap() != Phase::Converged {}

@@ -16,8 +16,9 @@ use crate::cli::{BenchArgs, BenchShape};
 use crate::outln;
 use crate::output::{number, print_json};
 
-/// Bumped whenever a cached bed of an earlier build can no longer be read back.
-const BED_FORMAT: u32 = 2;
+/// Bumped whenever a cached bed of an earlier build should no longer be used. Beds are stored as
+/// JSON, so one whose layout no longer matches fails to read and is built again.
+const BED_FORMAT: u32 = 5;
 /// The shaking of §4.3 (Eq. 14): amplitude 3e-4 m, period 0.025 s.
 const SHAKING: Shaking = Shaking { amplitude: 3e-4, period: 0.025 };
 /// Steps run before the clock starts, so that caches are warm and contacts cached.
@@ -123,9 +124,9 @@ fn default_cache() -> PathBuf {
 /// The settled bed of `spec`, read from the cache or built (with a progress line) and stored
 /// there atomically.
 fn cached_bed(spec: &BedSpec, cache: &Path, quiet: bool) -> anyhow::Result<Simulation> {
-    let path = cache.join(format!("{}-v{}-f{BED_FORMAT}.bed", spec.name(), solver::VERSION));
+    let path = cache.join(format!("{}-v{}-f{BED_FORMAT}.json", spec.name(), solver::VERSION));
     if let Ok(bytes) = std::fs::read(&path)
-        && let Ok(sim) = postcard::from_bytes::<Simulation>(&bytes)
+        && let Ok(sim) = serde_json::from_slice::<Simulation>(&bytes)
         && sim.bodies.len() == spec.grains
         && sim.bodies.position.iter().all(|p| p.iter().all(|c| c.is_finite()))
     {
@@ -145,7 +146,7 @@ fn cached_bed(spec: &BedSpec, cache: &Path, quiet: bool) -> anyhow::Result<Simul
     bar.finish_and_clear();
     std::fs::create_dir_all(cache).with_context(|| format!("{}", cache.display()))?;
     let temporary = path.with_extension("tmp");
-    std::fs::write(&temporary, postcard::to_allocvec(&sim)?).with_context(|| format!("{}", temporary.display()))?;
+    std::fs::write(&temporary, serde_json::to_vec(&sim)?).with_context(|| format!("{}", temporary.display()))?;
     std::fs::rename(&temporary, &path).with_context(|| format!("{}", path.display()))?;
     Ok(sim)
 }

@@ -46,9 +46,6 @@ pub struct LinearSpringDashpot {
 pub struct ContactHistory {
     /// Tangential spring displacement δ_t of Eq. 7 (zero when the contact is open).
     pub tangential_displacement: Vector3<f64>,
-    /// Last contact normal, or while apart the last separating direction found: the warm start
-    /// of the narrow phase (zero when unknown).
-    pub normal: Vector3<f64>,
 }
 
 impl LinearSpringDashpot {

@@ -283,7 +283,7 @@ impl Simulation {
             let a = bodies.shape[i].piece(ka, xi, &bodies.orientation[i], &poses[i]);
             let b = bodies.shape[j].piece(kb, xj, &bodies.orientation[j], &poses[j]);
             let travel = bodies.travel[i] + bodies.travel[j];
-            let full = contact::between(&a, &b, &mut Vector3::zeros(), &mut PairCache::default(), travel, Mode::Full);
+            let full = contact::between(&a, &b, &mut PairCache::default(), travel, Mode::Full);
             audit.pairs += 1;
             let cache = self.neighbours.cache[k];
             if cache.still_apart(travel) {
@@ -291,8 +291,7 @@ impl Simulation {
                 audit.wrongly_skipped += usize::from(full.is_some());
                 continue;
             }
-            let mut warm = self.neighbours.history[k].normal;
-            let fast = contact::between(&a, &b, &mut warm, &mut cache.clone(), travel, Mode::Coherent);
+            let fast = contact::between(&a, &b, &mut cache.clone(), travel, Mode::Coherent);
             let size = a.bounding_radius() + b.bounding_radius();
             match (full, fast) {
                 (Some(f), Some(c)) => {
@@ -358,7 +357,7 @@ impl Simulation {
                     let a = bodies.shape[i].piece(ka, xi, &bodies.orientation[i], &poses[i]);
                     let b = bodies.shape[j].piece(kb, xj, &bodies.orientation[j], &poses[j]);
                     let scale = a.smallest_half_extent().min(b.smallest_half_extent());
-                    (contact::between(&a, &b, &mut history.normal, cache, travel, Mode::Coherent), scale)
+                    (contact::between(&a, &b, cache, travel, Mode::Coherent), scale)
                 };
                 let Some(geometry) = geometry else {
                     history.tangential_displacement = Vector3::zeros();
@@ -429,29 +428,23 @@ impl Simulation {
                 }
                 for piece in 0..shape.pieces() {
                     let p = shape.piece(piece, *x, q, pose);
-                    for (wall, manifold) in
-                        [(0, contact::with_floor_manifold(&p)), (1, contact::with_wall_manifold(&p, &domain))]
-                    {
-                        let Some(m) = manifold else { continue };
-                        for j in 0..m.len {
-                            let key = WallPoint::key(wall, piece, m.features[j]);
-                            let entry = match walls.iter().position(|e| e.key == key) {
-                                Some(found) => &mut walls[found],
-                                None => {
-                                    walls.push(WallPoint { key, history: ContactHistory::default(), open: false });
-                                    walls.last_mut().expect("just pushed")
-                                }
-                            };
-                            entry.open = true;
-                            let g = m.point(j);
-                            // The wall is body B, immovable: m_eff = m and its velocity is zero.
-                            let arm = g.point - *x;
-                            let relative = -(*v + w.cross(&arm));
-                            let f = -law.force(mass * m.weights[j], &g, &relative, &mut entry.history, dt);
-                            force += f;
-                            torque += arm.cross(&f);
-                        }
-                    }
+                    contact::with_walls(&p, &domain, |wall, feature, g, weight| {
+                        let key = WallPoint::key(wall, piece, feature);
+                        let entry = match walls.iter().position(|e| e.key == key) {
+                            Some(found) => &mut walls[found],
+                            None => {
+                                walls.push(WallPoint { key, history: ContactHistory::default(), open: false });
+                                walls.last_mut().expect("just pushed")
+                            }
+                        };
+                        entry.open = true;
+                        // The wall is body B, immovable: m_eff = m and its velocity is zero.
+                        let arm = g.point - *x;
+                        let relative = -(*v + w.cross(&arm));
+                        let f = -law.force(mass * weight, g, &relative, &mut entry.history, dt);
+                        force += f;
+                        torque += arm.cross(&f);
+                    });
                 }
                 walls.retain(|e| e.open);
                 let wall_contacts = walls.len();

@@ -79,6 +79,21 @@ pub fn small_bed(shape: ShapeKind, mass: f64, spacing: f64, shaking_duration: f6
     spec
 }
 
+/// [`small_bed`] with 5 cm of shaking, these grains' forms and meshes, a 4 mm trim and seed 3.
+pub fn small_bed_of(
+    shape: ShapeKind,
+    form: solver::packing::FormSpec,
+    meshes: Option<solver::grain::MeshLibrary>,
+    mass: f64,
+) -> PackingSpec {
+    let mut spec = small_bed(shape, mass, 0.012, 0.05);
+    spec.grains.form = form;
+    spec.grains.meshes = meshes;
+    spec.trim = Some(4e-3);
+    spec.seed = 3;
+    spec
+}
+
 /// Steps until the bodies have separated after their first contact; returns the contact steps.
 pub fn collide(sim: &mut Simulation) -> u64 {
     let (mut steps, mut touched) = (0, false);

@@ -320,9 +320,7 @@ impl Wedge {
 
 /// Calls `clip` with the outward unit normal and the plane offset (normal · x on the plane) of
 /// every face of `body` (centred at `center`) with a vertex beyond `level` on `side` along
-/// `axis`, found by walking the vertex graph from the vertex farthest towards `side` through the
-/// vertices beyond (a connected set on a convex polyhedron). `None` if there are more than the
-/// buffers hold, or if `clip` says so.
+/// `axis`. `None` if there are more than the buffers hold, or if `clip` says so.
 fn for_each_face_beyond(
     body: &PolyhedronPose,
     center: &V3,
@@ -332,9 +330,26 @@ fn for_each_face_beyond(
     mut clip: impl FnMut(V3, f64) -> Option<()>,
 ) -> Option<()> {
     let shape = body.shape();
-    let toward = axis * side;
     let beyond = |v: u32| side * (axis.dot(&(center + body.vertex(v))) - level) > 0.0;
-    let top = shape.climb(&body.local(&toward), shape.start(&body.local(&toward)));
+    triangles_beyond(body, &(axis * side), beyond, |t| {
+        let normal = body.normal(t);
+        clip(normal, normal.dot(&(center + body.vertex(shape.triangles()[t as usize][0]))))
+    })
+}
+
+/// Calls `visit` once with every triangle of `body` that has a vertex for which `beyond`
+/// holds, found by walking the vertex graph from the vertex farthest along world direction
+/// `toward` through the vertices beyond (those beyond a plane are connected on a convex
+/// polyhedron). `None` if there are more than the buffers hold, or if `visit` says so.
+fn triangles_beyond(
+    body: &PolyhedronPose,
+    toward: &V3,
+    beyond: impl Fn(u32) -> bool,
+    mut visit: impl FnMut(u32) -> Option<()>,
+) -> Option<()> {
+    let shape = body.shape();
+    let direction = body.local(toward);
+    let top = shape.climb(&direction, shape.start(&direction));
     if !beyond(top) {
         return Some(());
     }
@@ -356,8 +371,7 @@ fn for_each_face_beyond(
             }
             taken[n_taken] = t;
             n_taken += 1;
-            let normal = body.normal(t);
-            clip(normal, normal.dot(&(center + body.vertex(shape.triangles()[t as usize][0]))))?;
+            visit(t)?;
         }
         for &w in shape.neighbours_of(v) {
             if !seen[..n_seen].contains(&w) && beyond(w) {
@@ -761,51 +775,26 @@ impl Slab {
             let x = &shape.vertices()[v as usize];
             V3::new(axes[0].dot(x), axes[1].dot(x), axes[2].dot(x)) + shift
         };
-        let beyond = |v: u32| side * (at(v).z - level) > 0.0;
         let slab = self;
         slab.len = 0;
         slab.lo = V2::repeat(f64::INFINITY);
         slab.hi = V2::repeat(f64::NEG_INFINITY);
-        let top = shape.climb(&(axes[2] * side), shape.start(&(axes[2] * side)));
-        if !beyond(top) {
-            return Some(());
-        }
-        let mut seen = [0u32; CAP_VERTICES];
-        let mut n_seen = 1;
-        seen[0] = top;
-        let mut taken = [0u32; CAP_TRIANGLES];
-        let mut next = 0;
-        while next < n_seen {
-            let v = seen[next];
-            next += 1;
-            for &t in shape.incident_to(v) {
-                if taken[..slab.len].contains(&t) {
-                    continue;
-                }
-                if slab.len == CAP_TRIANGLES {
-                    return None;
-                }
+        triangles_beyond(
+            pose,
+            &(frame.n * side),
+            |v| side * (at(v).z - level) > 0.0,
+            |t| {
                 let p = shape.triangles()[t as usize].map(at);
                 let normal = frame.coordinates(&pose.normal(t));
-                taken[slab.len] = t;
                 for corner in &p {
                     slab.lo = slab.lo.inf(&corner.xy());
                     slab.hi = slab.hi.sup(&corner.xy());
                 }
                 slab.facets[slab.len] = Facet { p, normal, offset: normal.dot(&p[0]) };
                 slab.len += 1;
-            }
-            for &w in shape.neighbours_of(v) {
-                if beyond(w) && !seen[..n_seen].contains(&w) {
-                    if n_seen == CAP_VERTICES {
-                        return None;
-                    }
-                    seen[n_seen] = w;
-                    n_seen += 1;
-                }
-            }
-        }
-        Some(())
+                Some(())
+            },
+        )
     }
 
     /// Adds the parts of these facets that lie inside all of `other`'s facet planes. A facet

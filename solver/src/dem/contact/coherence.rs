@@ -11,11 +11,15 @@
 //!   still holds the origin EPA starts from it and, when the contact's features have not
 //!   changed, ends after one support query. The answer is EPA's exact one either way.
 
+use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 /// What the narrow phase keeps for one pair of pieces.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct PairCache {
+    /// The last contact normal, or while apart the last separating direction found: where the
+    /// next query starts (zero when unknown).
+    pub warm: Vector3<f64>,
     /// A lower bound on the pieces' distance when it was last computed; 0 when unknown or in
     /// contact.
     pub gap: f64,

@@ -83,40 +83,25 @@ impl Piece<'_> {
     }
 }
 
-/// Contact of piece A with piece B. `warm` carries a direction from one step to the next: on
-/// entry the pair's last contact normal or separating direction (zero if none), on exit the
-/// one found now (zero if none), so that both touching and merely close pairs start warm.
-/// `cache` carries the rest of what the pair keeps ([`coherence`]); `travel` is the two
-/// bodies' travel sum now, recorded with a new distance bound. `mode` says whether the
-/// polyhedron shortcuts may be taken.
+/// Contact of piece A with piece B. `cache` carries what the pair keeps from one step to the
+/// next ([`coherence`]): on entry its last contact normal or separating direction, on exit the
+/// one found now, so that both touching and merely close pairs start warm, and the distance
+/// bound of a pair found apart, recorded at the two bodies' travel sum `travel`. `mode` says
+/// whether the polyhedron shortcuts may be taken.
 #[inline(always)]
-pub fn between(
-    a: &Piece,
-    b: &Piece,
-    warm: &mut Vector3<f64>,
-    cache: &mut PairCache,
-    travel: f64,
-    mode: Mode,
-) -> Option<ContactGeometry> {
+pub fn between(a: &Piece, b: &Piece, cache: &mut PairCache, travel: f64, mode: Mode) -> Option<ContactGeometry> {
     match (a, b) {
         (Piece::Sphere { center: ca, radius: ra }, Piece::Sphere { center: cb, radius: rb }) => {
             sphere::sphere_sphere(ca, *ra, cb, *rb)
         }
-        _ => curved(a, b, warm, cache, travel, mode),
+        _ => curved(a, b, cache, travel, mode),
     }
 }
 
 /// The non-spherical pairs, kept out of line so that the sphere path stays small.
 #[inline(never)]
-fn curved(
-    a: &Piece,
-    b: &Piece,
-    warm: &mut Vector3<f64>,
-    cache: &mut PairCache,
-    travel: f64,
-    mode: Mode,
-) -> Option<ContactGeometry> {
-    let start = (*warm != Vector3::zeros()).then_some(*warm);
+fn curved(a: &Piece, b: &Piece, cache: &mut PairCache, travel: f64, mode: Mode) -> Option<ContactGeometry> {
+    let start = (cache.warm != Vector3::zeros()).then_some(cache.warm);
     let flip = |c: ContactGeometry| ContactGeometry { normal: -c.normal, ..c };
     let flip_apart = |a: Apart| Apart { direction: -a.direction, ..a };
     let (contact, apart) = match (a, b) {
@@ -146,36 +131,51 @@ fn curved(
     };
     match &contact {
         Some(c) => {
-            *warm = c.normal;
+            cache.warm = c.normal;
             cache.gap = 0.0;
         }
         None => {
-            *warm = apart.direction;
+            cache.warm = apart.direction;
             cache.set_gap(apart.gap, travel, a.bounding_radius() + b.bounding_radius());
         }
     }
     contact
 }
 
-/// Contact of a piece with the floor z = 0, as a manifold: a polyhedron's face lying on the
-/// floor spreads over its corners, every other contact is one point.
+/// Every point of a piece's contacts with the floor (wall 0) and the cylinder wall (wall 1):
+/// `point(wall, key, contact, weight)`. A polyhedron's face lying on a wall spreads over its
+/// corners ([`manifold`]); every other contact is one point of weight 1 keyed
+/// [`manifold::SINGLE`].
 #[inline]
-pub fn with_floor_manifold(p: &Piece) -> Option<Manifold> {
-    match p {
-        Piece::Polyhedron(pose) => polyhedron::polyhedron_plane_manifold(pose, &Vector3::zeros(), &Vector3::z()),
-        _ => with_floor(p).map(Manifold::single),
+pub fn with_walls(p: &Piece, domain: &Domain, mut point: impl FnMut(u32, u64, &ContactGeometry, f64)) {
+    if let Piece::Polyhedron(pose) = p {
+        polyhedron_walls(pose, domain, &mut point);
+        return;
+    }
+    if let Some(g) = with_floor(p) {
+        point(0, manifold::SINGLE, &g, 1.0);
+    }
+    if let Some(g) = with_wall(p, domain) {
+        point(1, manifold::SINGLE, &g, 1.0);
     }
 }
 
-/// Contact of a piece with the cylinder wall, if the domain has one, as a manifold.
-#[inline]
-pub fn with_wall_manifold(p: &Piece, domain: &Domain) -> Option<Manifold> {
-    match (p, domain) {
-        (Piece::Polyhedron(pose), Domain::Cylinder { diameter }) => {
+#[inline(never)]
+fn polyhedron_walls(pose: &PolyhedronPose, domain: &Domain, point: &mut impl FnMut(u32, u64, &ContactGeometry, f64)) {
+    let floor = polyhedron::polyhedron_plane_manifold(pose, &Vector3::zeros(), &Vector3::z());
+    let wall = match *domain {
+        Domain::Cylinder { diameter } => {
             let c = diameter / 2.0;
             polyhedron::polyhedron_cylinder_wall_manifold(pose, c, c, c)
         }
-        _ => with_wall(p, domain).map(Manifold::single),
+        Domain::Periodic { .. } => None,
+    };
+    for (w, m) in [(0, floor), (1, wall)] {
+        if let Some(m) = m {
+            for j in 0..m.len {
+                point(w, m.features[j], &m.point(j), m.weights[j]);
+            }
+        }
     }
 }
 

@@ -446,6 +446,13 @@ pub fn polyhedron_sphere(a: &PolyhedronPose, center: &V3, radius: f64) -> (Optio
 /// points into the wall. Exact; the point is the centroid of the part beyond the plane, at
 /// half the depth.
 pub fn polyhedron_plane(a: &PolyhedronPose, plane_point: &V3, plane_normal: &V3) -> Option<ContactGeometry> {
+    plane_depth(a, plane_point, plane_normal)
+        .map(|(n, level, deepest, depth)| plane_contact(a, &n, level, deepest, depth))
+}
+
+/// How A enters the wall behind the plane: the normal into the wall, the plane's level along it
+/// from A's centre, A's vertex farthest in and its depth; `None` while A lies wholly in front.
+fn plane_depth(a: &PolyhedronPose, plane_point: &V3, plane_normal: &V3) -> Option<(V3, f64, u32, f64)> {
     let n = -plane_normal;
     let level = n.dot(&(plane_point - a.center()));
     if level >= a.bounding_radius() {
@@ -454,7 +461,7 @@ pub fn polyhedron_plane(a: &PolyhedronPose, plane_point: &V3, plane_normal: &V3)
     let mut deepest = a.cold_hint(&n);
     let top = n.dot(&a.reach(&n, &mut deepest));
     let depth = top - level;
-    (depth > 0.0).then(|| plane_contact(a, &n, level, deepest, depth))
+    (depth > 0.0).then_some((n, level, deepest, depth))
 }
 
 /// Contact of a polyhedron (body A) inside a vertical cylinder wall (body B) of the given axis
@@ -519,15 +526,8 @@ fn penetration<A: Convex, B: Convex>(a: &A, b: &B, warm_normal: Option<&V3>, gap
 /// [`polyhedron_plane`] as a manifold ([`super::manifold`]): a face lying on the plane spreads
 /// the contact over its corners.
 pub fn polyhedron_plane_manifold(a: &PolyhedronPose, plane_point: &V3, plane_normal: &V3) -> Option<Manifold> {
-    let n = -plane_normal;
-    let level = n.dot(&(plane_point - a.center()));
-    if level >= a.bounding_radius() {
-        return None;
-    }
-    let mut deepest = a.cold_hint(&n);
-    let top = n.dot(&a.reach(&n, &mut deepest));
-    let depth = top - level;
-    (depth > 0.0).then(|| manifold_beyond(a, &n, level, deepest, depth))
+    plane_depth(a, plane_point, plane_normal)
+        .map(|(n, level, deepest, depth)| manifold_beyond(a, &n, level, deepest, depth))
 }
 
 /// [`polyhedron_cylinder_wall`] as a manifold on the wall's tangent plane.
