@@ -1,5 +1,6 @@
 //! Campaign files: a job template plus `grid:` (dotted key → list of values, expanded as a
-//! cartesian product) and `seeds:` (each grid point runs once per seed). Every job is resolved
+//! cartesian product), `seeds:` (each grid point runs once per seed) and an optional `executor:`
+//! block (where the jobs run, which is not part of any job). Every job is resolved
 //! in full and identified by a hash of its resolved spec, so that submitting a campaign twice
 //! adds nothing and adding grid values adds only the new jobs.
 
@@ -8,8 +9,8 @@ use std::path::Path;
 use anyhow::anyhow;
 use serde_json::{Map, Value as Json};
 use serde_norway::{Mapping, Value};
-use sha2::{Digest, Sha256};
 
+use crate::executor::Request;
 use crate::job_file::{Source, parse_job_value, read_yaml};
 use crate::spec::{JobSpec, resolve};
 use crate::stored;
@@ -20,6 +21,8 @@ pub struct Campaign {
     /// The campaign file as submitted.
     pub text: String,
     pub jobs: Vec<PlannedJob>,
+    /// What the `executor:` block asks for (nothing without one).
+    pub executor: Request,
 }
 
 #[derive(Debug, Clone)]
@@ -30,18 +33,24 @@ pub struct PlannedJob {
     pub parameters: Map<String, Json>,
 }
 
-/// Stable id of a resolved job: the first 16 hex digits of the SHA-256 of its stored JSON
-/// (which includes the campaign name, so ids never collide across campaigns).
-pub fn job_id(spec: &JobSpec) -> String {
-    let digest = Sha256::digest(stored::canonical_json(spec).as_bytes());
-    digest.iter().take(8).map(|b| format!("{b:02x}")).collect()
-}
-
 pub fn read_campaign(path: &Path) -> anyhow::Result<Campaign> {
     let (text, value) = read_yaml(path)?;
     let source = Source { path, text: &text };
     let Value::Mapping(mut template) = value else {
         return Err(anyhow!("{}: a campaign file must be a mapping of keys", path.display()));
+    };
+    let executor = match template.remove("executor") {
+        None => Request::default(),
+        Some(block) => {
+            let request: Request = serde_path_to_error::deserialize(block).map_err(|e| {
+                let key = match e.path().to_string().as_str() {
+                    "." => "executor".to_string(),
+                    path => format!("executor.{path}"),
+                };
+                source.error(&key, e.into_inner())
+            })?;
+            request.checked_block().map_err(|(key, message)| source.error(key, message))?
+        }
     };
     let grid = match template.remove("grid") {
         None => Vec::new(),
@@ -84,7 +93,7 @@ pub fn read_campaign(path: &Path) -> anyhow::Result<Campaign> {
             let spec = resolve(file, &source)
                 .map_err(|e| if point.is_empty() { e } else { e.context(format!("grid point {}", describe())) })?;
             parameters.insert("seed".into(), Json::from(spec.packing.seed));
-            let id = job_id(&spec);
+            let id = stored::job_id(&spec);
             if let Some(twin) = jobs.iter().find(|j| j.id == id) {
                 return Err(anyhow!(
                     "{}: grid points {:?} and {:?} give the same job: a grid key has no effect",
@@ -97,7 +106,7 @@ pub fn read_campaign(path: &Path) -> anyhow::Result<Campaign> {
         }
     }
     let name = jobs[0].spec.name.clone();
-    Ok(Campaign { name, text, jobs })
+    Ok(Campaign { name, text, jobs, executor })
 }
 
 /// The grid as (dotted key, values) in file order; every list must be non-empty.

@@ -31,8 +31,11 @@ pub enum Command {
     Porosity(PorosityArgs),
     /// Submit a campaign to the database and run its pending jobs.
     Run(RunArgs),
-    /// Finish a campaign after an interruption: jobs of dead runners are run again.
+    /// Finish a campaign after an interruption: jobs of dead runners are run again, jobs that
+    /// stopped in Slurm are submitted again.
     Resume(ResumeArgs),
+    /// Cancel a Slurm campaign's tasks and return their jobs to pending.
+    Cancel(CancelArgs),
     /// Jobs per state, failures, time spent and left.
     Status(StatusArgs),
     /// One CSV row per job: parameters, porosity and grain statistics.
@@ -45,6 +48,10 @@ pub enum Command {
     /// Terminal settling velocity of one grain in still water (the second paper's drag and lift),
     /// beside Haider & Levenspiel's and Dietrich's correlations.
     Settle(SettleArgs),
+    /// Run one job of a Slurm campaign in its folder of the run directory (what each Slurm task
+    /// runs; never opens the database).
+    #[command(hide = true)]
+    Task(TaskArgs),
 }
 
 /// The grain shapes `sedpack settle` drops.
@@ -147,7 +154,7 @@ const DEFAULT_DB: &str = "sedpack.db";
 
 #[derive(Debug, Args)]
 pub struct RunArgs {
-    /// A campaign file (YAML): a job template plus `grid:` and `seeds:`.
+    /// A campaign file (YAML): a job template plus `grid:`, `seeds:` and `executor:`.
     pub campaign: PathBuf,
     #[arg(long, default_value = DEFAULT_DB)]
     pub db: PathBuf,
@@ -155,12 +162,47 @@ pub struct RunArgs {
     /// among them.
     #[arg(long)]
     pub workers: Option<usize>,
+    #[command(flatten)]
+    pub executor: ExecutorArgs,
+    #[command(flatten)]
+    pub common: ContinueArgs,
+}
+
+/// Where the jobs run: the keys of a campaign file's `executor:` block.
+#[derive(Debug, Args)]
+pub struct ExecutorArgs {
+    /// local: this machine's workers (default); slurm: Slurm job arrays, one task per job
+    /// (default: the campaign file's `executor.kind`, else what the campaign was submitted with).
+    #[arg(long, value_enum)]
+    pub executor: Option<crate::executor::Kind>,
+    /// More sbatch arguments, one quoted string (e.g. "--partition=compute --account=geo").
+    #[arg(long, allow_hyphen_values = true, value_name = "ARGS")]
+    pub sbatch: Option<String>,
+    /// CPUs of each Slurm task, the threads of its packing (default 1).
+    #[arg(long)]
+    pub cpus_per_task: Option<usize>,
+    /// Wall-time limit of each Slurm task, HH:MM:SS or D-HH:MM:SS; a task is told to checkpoint
+    /// and stop shortly before it, and `resume` continues it.
+    #[arg(long, value_parser = crate::executor::TimeLimit::parse)]
+    pub time: Option<crate::executor::TimeLimit>,
+    /// Tasks of one Slurm job array running at once.
+    #[arg(long)]
+    pub max_parallel: Option<usize>,
+}
+
+/// Options of both `run` and `resume`.
+#[derive(Debug, Args)]
+pub struct ContinueArgs {
     /// Return failed jobs to pending and try them again.
     #[arg(long)]
     pub retry_failed: bool,
     /// Wall-clock seconds between checkpoints of a running packing.
     #[arg(long, default_value_t = 300.0)]
     pub checkpoint_interval: f64,
+    /// Slurm: follow the jobs until they end, submitting again those that stopped before their
+    /// time limit (without it, return once they are submitted).
+    #[arg(long)]
+    pub wait: bool,
     /// No progress bars.
     #[arg(long)]
     pub quiet: bool,
@@ -174,10 +216,31 @@ pub struct ResumeArgs {
     pub db: PathBuf,
     #[arg(long)]
     pub workers: Option<usize>,
+    #[command(flatten)]
+    pub common: ContinueArgs,
+}
+
+#[derive(Debug, Args)]
+pub struct CancelArgs {
+    /// The campaign's name.
+    pub name: String,
+    #[arg(long, default_value = DEFAULT_DB)]
+    pub db: PathBuf,
+}
+
+#[derive(Debug, Args)]
+pub struct TaskArgs {
+    /// The job's folder in the run directory (it holds job.json).
+    pub job_dir: PathBuf,
+    /// Threads of the packing.
+    #[arg(long, default_value_t = 1)]
+    pub threads: usize,
+    /// Wall-clock seconds between checkpoints.
     #[arg(long, default_value_t = 300.0)]
     pub checkpoint_interval: f64,
+    /// The submission the task belongs to, recorded with its events.
     #[arg(long)]
-    pub quiet: bool,
+    pub submission: Option<String>,
 }
 
 #[derive(Debug, Args)]

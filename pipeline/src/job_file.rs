@@ -272,7 +272,7 @@ pub fn read_job_file(path: &Path) -> anyhow::Result<(String, JobFile)> {
     let (text, value) = read_yaml(path)?;
     let source = Source { path, text: &text };
     if let serde_norway::Value::Mapping(map) = &value {
-        for key in ["grid", "seeds"] {
+        for key in ["grid", "seeds", "executor"] {
             if map.contains_key(key) {
                 return Err(source.error(key, "is a campaign key: run campaigns with `sedpack run`"));
             }

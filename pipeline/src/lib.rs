@@ -7,11 +7,13 @@
 pub mod campaign;
 pub mod cli;
 pub mod commands;
+pub mod executor;
 pub mod job_file;
 pub mod meshes;
 pub mod output;
 pub mod records;
 pub mod runner;
+pub mod slurm;
 pub mod spec;
 pub mod stored;
 pub mod vtk;
@@ -28,10 +30,12 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Porosity(args) => commands::porosity::run(&args),
         Command::Run(args) => commands::campaign::run(&args),
         Command::Resume(args) => commands::campaign::resume(&args),
+        Command::Cancel(args) => commands::campaign::cancel(&args),
         Command::Status(args) => commands::campaign::status(&args),
         Command::Export(args) => commands::campaign::export(&args),
         Command::Report(args) => commands::report::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
         Command::Settle(args) => commands::settle::run(&args),
+        Command::Task(args) => slurm::task::run(&args),
     }
 }

@@ -16,6 +16,11 @@ pub const PEBBLES: &str = "builtin:pebbles";
 /// Pebbles in `builtin:pebbles`, generated from seed 1.
 const PEBBLE_COUNT: usize = 20;
 
+/// Whether a library is one shipped with sedpack rather than a folder.
+pub fn is_builtin(source: &str) -> bool {
+    [RHINE, PEBBLES].contains(&source)
+}
+
 /// Loads and prepares a library. A folder is given relative to `base` (the job file's folder)
 /// and stored as an absolute path.
 pub fn load(source: &str, faces: usize, base: &Path) -> anyhow::Result<MeshLibrary> {
@@ -33,7 +38,8 @@ pub fn load(source: &str, faces: usize, base: &Path) -> anyhow::Result<MeshLibra
 
 /// Fills in the meshes of a library read back from the store and checks they are the same.
 pub fn reload(library: &mut MeshLibrary) -> anyhow::Result<()> {
-    let meshes = prepare(&library.source, library.faces)?;
+    let meshes = prepare(&library.source, library.faces)
+        .with_context(|| format!("grains.meshes: the meshes of {} cannot be read", library.source))?;
     if digest(&meshes) != library.digest {
         return Err(anyhow!("{}: the meshes changed since the job was submitted", library.source));
     }

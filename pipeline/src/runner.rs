@@ -12,8 +12,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::anyhow;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
-use solver::packing::{Packing, PackingResult, Phase};
-use store::{Checkpoint, ClaimedJob, Store};
+use solver::packing::{Packing, PackingResult, Phase, Progress};
+use store::{ClaimedJob, Store};
 use tokio::sync::mpsc;
 use tracing::{info, warn};
 
@@ -26,12 +26,13 @@ use crate::stored;
 const HEARTBEAT: Duration = Duration::from_secs(10);
 /// A job whose heartbeat is older than this belongs to a dead runner.
 const STALE_AFTER: Duration = Duration::from_secs(60);
-/// Time steps between progress reports and cancellation checks (0.05 s simulated at the default Δt).
-const STEPS_PER_REPORT: u64 = 10_000;
+/// Time steps between progress reports and stop checks (0.01 s simulated at the default Δt), few
+/// enough that a large packing stops within seconds when Slurm's time limit nears.
+const STEPS_PER_REPORT: u64 = 2_000;
 /// A checkpoint is this number followed by the packing; a checkpoint with another number was
 /// written by another version of sedpack and is not used. Raise it whenever `Packing`'s
 /// serialised form changes.
-const CHECKPOINT_FORMAT: u32 = 3;
+const CHECKPOINT_FORMAT: u32 = 4;
 
 #[derive(Debug, Clone)]
 pub struct RunOptions {
@@ -55,9 +56,11 @@ enum Message {
     Warning(String),
 }
 
-enum Outcome {
+/// How a packing loop ended.
+pub(crate) enum Outcome {
     Done(Box<PackingResult>),
-    Cancelled,
+    /// Asked to stop, or its checkpoint could not be kept: the packing as it stands.
+    Stopped(Box<Packing>),
     Failed(String),
 }
 
@@ -238,7 +241,7 @@ impl Worker {
                 summary.completed += 1;
                 self.total.inc(1);
             }
-            Outcome::Cancelled => {
+            Outcome::Stopped(_) => {
                 if self.store.release(&claimed.id, &self.id).await? {
                     info!(job = %claimed.id, "returned to pending");
                 }
@@ -268,7 +271,8 @@ impl Worker {
         let interval = self.checkpoint_interval;
         let id = job.to_string();
         let mut task = tokio::task::spawn_blocking(move || {
-            pool.install(|| simulate(&id, spec, checkpoint, &sender, &stop, interval))
+            let mut relay = Relay { sender: &sender, stop: &stop };
+            pool.install(|| simulate(&id, spec, checkpoint.as_ref().map(|c| &c.data[..]), &mut relay, interval))
         });
         let mut heartbeat = tokio::time::interval(HEARTBEAT);
         loop {
@@ -307,24 +311,57 @@ impl Worker {
     }
 }
 
-/// The packing loop of a worker: from a checkpoint or from scratch, reporting progress and
-/// writing checkpoints, until converged, failed or cancelled.
-fn simulate(
+/// Where a packing loop reports to, and learns whether to stop.
+pub(crate) trait Observer {
+    fn progress(&mut self, progress: Progress);
+    /// Keeps a checkpoint; false when it cannot, and the packing stops.
+    fn checkpoint(&mut self, data: Vec<u8>, simulated_time: f64) -> bool;
+    /// Something the user should know, such as a checkpoint that cannot be used.
+    fn warning(&mut self, text: String);
+    fn stop_requested(&self) -> bool;
+}
+
+/// A local worker's packing reports through a channel and stops on Ctrl-C or a lost job.
+struct Relay<'a> {
+    sender: &'a mpsc::Sender<Message>,
+    stop: &'a [Arc<AtomicBool>; 2],
+}
+
+impl Observer for Relay<'_> {
+    fn progress(&mut self, progress: Progress) {
+        // A full channel only delays the display; the packing never waits for it.
+        let _ = self.sender.try_send(Message::Progress(progress));
+    }
+
+    fn checkpoint(&mut self, data: Vec<u8>, simulated_time: f64) -> bool {
+        self.sender.blocking_send(Message::Checkpoint(data, simulated_time)).is_ok()
+    }
+
+    fn warning(&mut self, text: String) {
+        let _ = self.sender.blocking_send(Message::Warning(text));
+    }
+
+    fn stop_requested(&self) -> bool {
+        self.stop.iter().any(|s| s.load(Ordering::SeqCst))
+    }
+}
+
+/// The packing loop: from a checkpoint or from scratch, reporting progress and writing
+/// checkpoints, until converged, failed or stopped.
+pub(crate) fn simulate(
     job: &str,
     spec: JobSpec,
-    checkpoint: Option<Checkpoint>,
-    sender: &mpsc::Sender<Message>,
-    stop: &[Arc<AtomicBool>; 2],
+    checkpoint: Option<&[u8]>,
+    observer: &mut impl Observer,
     interval: Duration,
 ) -> Outcome {
-    let restored = checkpoint.and_then(|c| match restore(&c.data, &spec) {
+    let restored = checkpoint.and_then(|data| match restore(data, &spec) {
         Ok(packing) => {
-            info!(job, simulated_time = c.simulated_time, "resuming from a checkpoint");
+            info!(job, simulated_time = packing.simulation.time, "resuming from a checkpoint");
             Some(packing)
         }
         Err(why) => {
-            let _ =
-                sender.blocking_send(Message::Warning(format!("its checkpoint cannot be used: {why}; starting over")));
+            observer.warning(format!("its checkpoint cannot be used: {why}; starting over"));
             None
         }
     });
@@ -342,16 +379,15 @@ fn simulate(
             Ok(_) => {}
             Err(e) => return Outcome::Failed(e.to_string()),
         }
-        // A full channel only delays the display; the packing never waits for it.
-        let _ = sender.try_send(Message::Progress(packing.progress()));
-        if stop.iter().any(|s| s.load(Ordering::SeqCst)) {
-            return Outcome::Cancelled;
+        observer.progress(packing.progress());
+        if observer.stop_requested() {
+            return Outcome::Stopped(Box::new(packing));
         }
         if last_checkpoint.elapsed() >= interval {
-            match postcard::to_allocvec(&(CHECKPOINT_FORMAT, &packing)) {
+            match checkpoint_data(&packing) {
                 Ok(data) => {
-                    if sender.blocking_send(Message::Checkpoint(data, packing.simulation.time)).is_err() {
-                        return Outcome::Cancelled;
+                    if !observer.checkpoint(data, packing.simulation.time) {
+                        return Outcome::Stopped(Box::new(packing));
                     }
                 }
                 Err(e) => warn!(error = %e, "could not serialise a checkpoint"),
@@ -363,6 +399,11 @@ fn simulate(
         Ok(result) => Outcome::Done(Box::new(result)),
         Err(e) => Outcome::Failed(e.to_string()),
     }
+}
+
+/// A checkpoint: this version's checkpoint format number followed by the packing.
+pub(crate) fn checkpoint_data(packing: &Packing) -> Result<Vec<u8>, postcard::Error> {
+    postcard::to_allocvec(&(CHECKPOINT_FORMAT, packing))
 }
 
 /// The packing a checkpoint holds, if this version wrote it for this job; otherwise why not.
@@ -386,7 +427,7 @@ fn restore(data: &[u8], spec: &JobSpec) -> Result<Packing, String> {
 }
 
 /// A stored job's spec, with its meshes loaded again and checked against their digest.
-fn read_spec(format: u32, json: &serde_json::Value) -> anyhow::Result<JobSpec> {
+pub(crate) fn read_spec(format: u32, json: &serde_json::Value) -> anyhow::Result<JobSpec> {
     let mut spec = stored::decode(format, json)?;
     if let Some(library) = &mut spec.packing.grains.meshes {
         meshes::reload(library)?;
@@ -411,7 +452,7 @@ mod tests {
     #[test]
     fn a_checkpoint_is_used_only_by_its_own_job_and_format_and_says_why_not() {
         let packing = Packing::new(job(1).packing).unwrap();
-        let data = postcard::to_allocvec(&(CHECKPOINT_FORMAT, &packing)).unwrap();
+        let data = checkpoint_data(&packing).unwrap();
         assert_eq!(restore(&data, &job(1)).unwrap().spec(), packing.spec());
         let other = restore(&data, &job(2)).unwrap_err();
         assert!(other.contains("another spec"), "{other}");

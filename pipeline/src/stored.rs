@@ -1,30 +1,44 @@
-//! The stored job: the JSON a job keeps in the database and whose hash is its id. Its format
-//! is written out here type by type, apart from the solver's types, so that changing those
-//! never changes a stored job or an id; every value is concrete (the paper's rules already
-//! applied), so a job runs the same whatever later versions take as defaults.
+//! The stored job: the JSON a job keeps in the database (and, for a Slurm task, in its job
+//! folder), and the identity whose hash is its id. Its format is written out here type by type,
+//! apart from the solver's types, so that changing those never changes a stored job or an id;
+//! every value is concrete (the paper's rules already applied), so a job runs the same whatever
+//! later versions take as defaults.
 //!
-//! Format 1 is the JSON of sedpack 0.1.0, byte for byte. A new format gets a new number (the
-//! `format` column of the jobs table) and its own types beside these. Format 2 is format 1 with
-//! fluid forces (`packing.fluid`), which format 1 has not: a job without them is written in
-//! format 1, the same bytes and id as before, and a version that knows only format 1 refuses a
-//! job with them instead of running it without.
+//! - Format 1 is the JSON of sedpack 0.1.0, byte for byte. A mesh folder is its absolute path,
+//!   so the id of such a job changed when the folder moved.
+//! - Format 2 (this version's) is `{"job": IDENTITY, "mesh_folder": PATH or null}`. IDENTITY is
+//!   format 1's JSON with a mesh folder named `folder` (its digest pins the meshes); the folder's
+//!   place is `mesh_folder`, outside the id. IDENTITY is byte for byte format 1's JSON for every
+//!   job without a mesh folder, so those ids are 0.1.0's.
+//! - Format 3 is format 2 whose identity has fluid forces (`packing.fluid`), which formats 1 and
+//!   2 have not: a job without them is still written in format 2, the same bytes and id as
+//!   before, and a version that knows only formats 1 and 2 refuses a job with them instead of
+//!   running it without.
+//!
+//! A stored format is frozen: a release that adds a field writes a new format with its own types
+//! beside these, keeps reading every older one (giving the new field the value that reproduces
+//! the older behaviour) and keeps the identity of jobs that leave the field at that value.
 
 use anyhow::{Context, bail};
 use nalgebra::Vector3;
+use sha2::{Digest, Sha256};
 use solver::dem::{Calibration, Domain, Material, Shaking};
 use solver::fluid::flow::Flow;
 use solver::grain::{FormDistribution, MeshLibrary, SieveCurve, Table3Case};
 use solver::packing::{FluidSpec, FormSpec, GrainSpec, PackingSpec, Process, ShapeKind};
 
+use crate::meshes;
 use crate::spec::JobSpec;
 
 /// The newest format this version reads and writes.
-pub const FORMAT: u32 = 2;
+pub const FORMAT: u32 = 3;
 
-/// The format a job is written in: the oldest that holds it.
+/// The format a job is written in: the oldest of this version's that holds it.
 pub fn format(job: &JobSpec) -> u32 {
-    if job.packing.fluid.is_some() { 2 } else { 1 }
+    if job.packing.fluid.is_some() { 3 } else { 2 }
 }
+/// A mesh folder's name in a format 2 identity.
+const FOLDER: &str = "folder";
 
 /// Format 1, the JSON of sedpack 0.1.0.
 mod v1 {
@@ -52,7 +66,7 @@ mod v1 {
         pub(super) cutoff: f64,
         pub(super) trim: Option<f64>,
         pub(super) seed: u64,
-        /// Format 2 only; absent, it leaves format 1's bytes as they were.
+        /// Format 3 only; absent, it leaves the bytes of formats 1 and 2 as they were.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub(super) fluid: Option<Fluid>,
     }
@@ -168,28 +182,72 @@ mod v1 {
     }
 }
 
-/// The stored JSON of a job, in its [`format`].
-pub fn encode(job: &JobSpec) -> serde_json::Value {
-    serde_json::to_value(stored(job)).expect("the stored job is plain numbers, strings and lists")
+/// Formats 2 and 3: format 1's job with the place of its mesh folder taken out of it.
+mod v2 {
+    use serde::{Deserialize, Serialize};
+
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub(super) struct Job {
+        /// Format 1's job with a mesh folder named `folder`: what the id hashes.
+        pub(super) job: super::v1::Job,
+        /// The mesh folder's absolute path when the job was (last) submitted.
+        pub(super) mesh_folder: Option<String>,
+    }
 }
 
-/// The stored JSON as text: the input of the job id.
+/// The stored JSON of a job, in its [`format`].
+pub fn encode(job: &JobSpec) -> serde_json::Value {
+    let mesh_folder = job.packing.grains.meshes.as_ref().map(|m| m.source.clone()).filter(|s| !meshes::is_builtin(s));
+    serde_json::to_value(v2::Job { job: identity(job), mesh_folder })
+        .expect("the stored job is plain numbers, strings and lists")
+}
+
+/// The JSON the job id hashes: the job without the place of its mesh folder.
 pub fn canonical_json(job: &JobSpec) -> String {
-    serde_json::to_string(&stored(job)).expect("the stored job is plain numbers, strings and lists")
+    serde_json::to_string(&identity(job)).expect("the stored job is plain numbers, strings and lists")
+}
+
+/// Stable id of a resolved job: the first 16 hex digits of the SHA-256 of its identity (which
+/// includes the campaign name, so ids never collide across campaigns).
+pub fn job_id(job: &JobSpec) -> String {
+    let digest = Sha256::digest(canonical_json(job).as_bytes());
+    digest.iter().take(8).map(|b| format!("{b:02x}")).collect()
 }
 
 /// The job a stored JSON of the given format describes. Its meshes, if any, are only named: the
 /// caller loads them again.
 pub fn decode(format: u32, json: &serde_json::Value) -> anyhow::Result<JobSpec> {
-    if !(1..=FORMAT).contains(&format) {
-        bail!("the job is stored in format {format}, which this version of sedpack (formats 1–{FORMAT}) cannot read");
+    let job = match format {
+        1 => serde_json::from_value(json.clone()).context("the stored job is not format 1")?,
+        2 | 3 => {
+            let v2::Job { mut job, mesh_folder } = serde_json::from_value(json.clone())
+                .with_context(|| format!("the stored job is not format {format}"))?;
+            let named = job.packing.grains.meshes.as_mut().map(|m| &mut m.source);
+            match (named, mesh_folder) {
+                (Some(source), Some(folder)) if source == FOLDER => *source = folder,
+                (Some(source), None) if meshes::is_builtin(source) => {}
+                (None, None) => {}
+                (source, folder) => bail!(
+                    "the stored job names its meshes {source:?} with the mesh folder {folder:?}: format 2 \
+                     names a builtin library without a folder, or `{FOLDER}` with one"
+                ),
+            }
+            job
+        }
+        _ => bail!(
+            "the job is stored in format {format}, which this version of sedpack (formats 1 to {FORMAT}) \
+             cannot read: a newer sedpack stored it"
+        ),
+    };
+    if job.packing.fluid.is_some() != (format == 3) {
+        bail!("the stored job is not format {format}: format 3 is the one with fluid forces");
     }
-    let job: v1::Job =
-        serde_json::from_value(json.clone()).with_context(|| format!("the stored job is not format {format}"))?;
+    from_v1(job)
+}
+
+fn from_v1(job: v1::Job) -> anyhow::Result<JobSpec> {
     let p = job.packing;
-    if p.fluid.is_some() != (format == 2) {
-        bail!("the stored job is not format {format}: format 2 is the one with fluid forces");
-    }
     let time_step = p.time_step;
     let calibration = match p.calibration {
         v1::Calibration::Continuous => Calibration::Continuous,
@@ -282,7 +340,8 @@ pub fn decode(format: u32, json: &serde_json::Value) -> anyhow::Result<JobSpec> 
     Ok(JobSpec { name: job.name, packing, experiment })
 }
 
-fn stored(job: &JobSpec) -> v1::Job {
+/// The job in format 1's types, a mesh folder named `folder`.
+fn identity(job: &JobSpec) -> v1::Job {
     let spec = &job.packing;
     let derived = spec.derived();
     let grains = &spec.grains;
@@ -317,7 +376,7 @@ fn stored(job: &JobSpec) -> v1::Job {
                     FormSpec::Own => v1::Form::Own,
                 },
                 meshes: grains.meshes.as_ref().map(|l| v1::Meshes {
-                    source: l.source.clone(),
+                    source: if meshes::is_builtin(&l.source) { l.source.clone() } else { FOLDER.into() },
                     faces: l.faces,
                     digest: l.digest.clone(),
                 }),
@@ -370,12 +429,23 @@ fn stored(job: &JobSpec) -> v1::Job {
 
 #[cfg(test)]
 mod tests {
+    use solver::grain::MeshLibrary;
     use solver::packing::DomainKind;
 
     use super::*;
 
     fn job(packing: PackingSpec) -> JobSpec {
         JobSpec { name: "j".into(), packing, experiment: Some(analysis::Experiment { porosity: 0.37, std: None }) }
+    }
+
+    /// A job of meshes from a folder at `place`; its meshes are named, not loaded.
+    fn folder_job(place: &str) -> JobSpec {
+        let mut packing = PackingSpec::paper(DomainKind::Periodic);
+        packing.grains.shape = ShapeKind::Mesh;
+        packing.grains.form = FormSpec::Own;
+        packing.grains.meshes =
+            Some(MeshLibrary { source: place.into(), faces: 100, digest: "0123abcd".into(), meshes: Vec::new() });
+        job(packing)
     }
 
     #[test]
@@ -394,39 +464,87 @@ mod tests {
     }
 
     #[test]
-    fn a_job_with_fluid_forces_is_format_2_and_reads_back_with_its_cell_concrete() {
+    fn a_job_without_a_mesh_folder_keeps_its_format_1_identity() {
+        let original = job(PackingSpec::paper(DomainKind::Periodic));
+        let stored = encode(&original);
+        assert_eq!(stored["mesh_folder"], serde_json::Value::Null);
+        assert_eq!(serde_json::to_string(&stored["job"]).unwrap(), canonical_json(&original));
+        // Format 1 is the identity itself, and reads back as the same job.
+        let v1: serde_json::Value = serde_json::from_str(&canonical_json(&original)).unwrap();
+        assert_eq!(job_id(&decode(1, &v1).unwrap()), job_id(&original));
+    }
+
+    #[test]
+    fn a_mesh_folder_moves_without_changing_the_id() {
+        let (here, there) = (folder_job("/data/scans"), folder_job("/scratch/me/scans"));
+        assert_eq!(job_id(&here), job_id(&there));
+        let stored = encode(&there);
+        assert_eq!(stored["job"]["packing"]["grains"]["meshes"]["source"], "folder");
+        assert_eq!(stored["mesh_folder"], "/scratch/me/scans");
+        let back = decode(2, &stored).unwrap();
+        assert_eq!(back.packing.grains.meshes.unwrap().source, "/scratch/me/scans");
+        // Another digest is another job.
+        let mut other = folder_job("/data/scans");
+        other.packing.grains.meshes.as_mut().unwrap().digest = "ffff".into();
+        assert_ne!(job_id(&other), job_id(&here));
+        // sedpack 0.1.0 stored the folder's path in the job (format 1): read back, it is the job
+        // of the same identity.
+        let mut v1 = stored["job"].clone();
+        v1["packing"]["grains"]["meshes"]["source"] = "/old/place/scans".into();
+        let old = decode(1, &v1).unwrap();
+        assert_eq!(old.packing.grains.meshes.as_ref().unwrap().source, "/old/place/scans");
+        assert_eq!(job_id(&old), job_id(&here));
+    }
+
+    #[test]
+    fn a_job_with_fluid_forces_is_format_3_and_reads_back_with_its_cell_concrete() {
         let mut spec = PackingSpec::paper(DomainKind::Periodic);
         spec.fluid = Some(FluidSpec {
             flow: Flow::Logarithmic { shear_velocity: 0.05, roughness: 2e-4 },
             ..FluidSpec::STILL_WATER
         });
         let original = job(spec);
-        assert_eq!(format(&original), 2);
+        assert_eq!(format(&original), 3);
         let stored = encode(&original);
-        assert_eq!(stored["packing"]["fluid"]["cell"], serde_json::json!(original.packing.derived().fluid_cell));
-        let back = decode(2, &stored).unwrap();
+        assert_eq!(stored["job"]["packing"]["fluid"]["cell"], serde_json::json!(original.packing.derived().fluid_cell));
+        let back = decode(3, &stored).unwrap();
         assert_eq!(back.packing.fluid.map(|f| f.flow), original.packing.fluid.map(|f| f.flow));
         assert_eq!(canonical_json(&back), canonical_json(&original));
-        let error = decode(1, &stored).unwrap_err().to_string();
-        assert!(error.contains("format 2 is the one with fluid forces"), "{error}");
-        // Without fluid forces the stored JSON has no `fluid` key: format 1's bytes.
-        assert!(encode(&job(PackingSpec::paper(DomainKind::Periodic)))["packing"].get("fluid").is_none());
+        for older in [1, 2] {
+            let json = if older == 1 { stored["job"].clone() } else { stored.clone() };
+            let error = decode(older, &json).unwrap_err().to_string();
+            assert!(error.contains("format 3 is the one with fluid forces"), "{error}");
+        }
+        // Without fluid forces the identity has no `fluid` key: format 1's bytes, format 2's id.
+        let plain = job(PackingSpec::paper(DomainKind::Periodic));
+        assert_eq!(format(&plain), 2);
+        assert!(encode(&plain)["job"]["packing"].get("fluid").is_none());
     }
 
     #[test]
     fn stored_jobs_that_disagree_with_themselves_or_another_format_are_refused() {
         let stored = encode(&job(PackingSpec::paper(DomainKind::Periodic)));
+        let error = decode(4, &stored).unwrap_err().to_string();
+        assert!(error.contains("format 4") && error.contains("formats 1 to 3"), "{error}");
+        let error = format!("{:#}", decode(1, &stored).unwrap_err());
+        assert!(error.contains("not format 1"), "{error}");
         let error = decode(3, &stored).unwrap_err().to_string();
-        assert!(error.contains("format 3"), "{error}");
-        let error = decode(2, &stored).unwrap_err().to_string();
         assert!(error.contains("fluid forces"), "{error}");
         let mut two_steps = stored.clone();
-        two_steps["packing"]["calibration"]["Discrete"]["time_step"] = serde_json::json!(1e-5);
-        let error = decode(1, &two_steps).unwrap_err().to_string();
+        two_steps["job"]["packing"]["calibration"]["Discrete"]["time_step"] = serde_json::json!(1e-5);
+        let error = decode(2, &two_steps).unwrap_err().to_string();
         assert!(error.contains("1e-5") || error.contains("0.00001"), "{error}");
-        let mut renamed = stored;
-        renamed["size_case"] = serde_json::json!("U7");
-        let error = decode(1, &renamed).unwrap_err().to_string();
+        let mut renamed = stored.clone();
+        renamed["job"]["size_case"] = serde_json::json!("U7");
+        let error = decode(2, &renamed).unwrap_err().to_string();
         assert!(error.contains("size case U7"), "{error}");
+        // A folder without its place, or a place without a folder.
+        let mut placeless = encode(&folder_job("/data/scans"));
+        placeless["mesh_folder"] = serde_json::Value::Null;
+        let error = decode(2, &placeless).unwrap_err().to_string();
+        assert!(error.contains("\"folder\"") && error.contains("None"), "{error}");
+        let mut stray = stored;
+        stray["mesh_folder"] = "/data/scans".into();
+        assert!(decode(2, &stray).is_err());
     }
 }

@@ -250,6 +250,21 @@ fn bad_campaigns_and_databases_are_refused_clearly() {
     fails(&["run", &typo, "--db", db], &["typo.yaml:4", "grains.mas"]);
     let grid_range = write(dir.path(), "range.yaml", "name: r\ngrid:\n  material.friction: [0.5, -1.0]\n");
     fails(&["run", &grid_range, "--db", db], &["material.friction", "-1", "grid point"]);
+    // The executor block: its keys, a time limit as Slurm writes it, Slurm keys with `local`.
+    let executor = |name: &str, block: &str| write(dir.path(), name, &format!("name: x\nexecutor:\n{block}"));
+    let typo = executor("typo-executor.yaml", "  kind: slurm\n  cpu_per_task: 2\n");
+    fails(&["run", &typo, "--db", db], &["typo-executor.yaml:4", "executor.cpu_per_task", "unknown field"]);
+    let time = executor("time.yaml", "  kind: slurm\n  time: 90\n");
+    fails(&["run", &time, "--db", db], &["time.yaml:4", "executor.time", "HH:MM:SS or D-HH:MM:SS"]);
+    let local = executor("local.yaml", "  kind: local\n  max_parallel: 4\n");
+    fails(
+        &["run", &local, "--db", db],
+        &["local.yaml:4", "executor.max_parallel", "applies to the slurm executor only"],
+    );
+    let slurm = executor("slurm.yaml", "  kind: slurm\n");
+    fails(&["run", &slurm, "--db", db, "--workers", "2"], &["--workers applies to the local executor"]);
+    let job = executor("job.yaml", "  kind: slurm\n");
+    fails(&["pack", &job], &["job.yaml:2", "executor: is a campaign key"]);
 
     // A corrupt file and a foreign SQLite database are refused and left exactly as they were.
     let ok_campaign = write(dir.path(), "ok.yaml", &campaign("ok", 0.05));

@@ -17,6 +17,7 @@ use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use serde::Serialize;
 use serde::de::DeserializeOwned;
+use serde_json::Value;
 use sqlx::sqlite::{
     SqliteConnectOptions, SqliteConnection, SqliteExecutor, SqlitePool, SqlitePoolOptions, SqliteSynchronous,
 };
@@ -24,7 +25,7 @@ use sqlx::sqlite::{
 pub use error::StoreError;
 pub use types::{
     Campaign, CampaignStatus, Checkpoint, ClaimedJob, ExportRow, Failure, GrainStatistic, JobResult, JobState, NewJob,
-    RunningJob,
+    RunningJob, StoredJob,
 };
 
 /// How long a statement waits for another connection's lock before it fails.
@@ -80,19 +81,31 @@ impl Store {
     }
 
     pub async fn campaign(&self, name: &str) -> Result<Campaign, StoreError> {
-        let row: Option<(String, String, f64, f64)> =
+        let row: Option<CampaignRow> =
             sqlx::query_as(sql::CAMPAIGN).bind(name).fetch_optional(&self.pool).await.map_err(self.db())?;
-        let (name, spec, created_at, updated_at) = row.ok_or_else(|| self.no_campaign(name))?;
-        Ok(Campaign { name, spec, created_at, updated_at })
+        self.campaign_of(row.ok_or_else(|| self.no_campaign(name))?)
     }
 
     pub async fn campaigns(&self) -> Result<Vec<Campaign>, StoreError> {
-        let rows: Vec<(String, String, f64, f64)> =
-            sqlx::query_as(sql::CAMPAIGNS).fetch_all(&self.pool).await.map_err(self.db())?;
-        Ok(rows
-            .into_iter()
-            .map(|(name, spec, created_at, updated_at)| Campaign { name, spec, created_at, updated_at })
-            .collect())
+        let rows: Vec<CampaignRow> = sqlx::query_as(sql::CAMPAIGNS).fetch_all(&self.pool).await.map_err(self.db())?;
+        rows.into_iter().map(|row| self.campaign_of(row)).collect()
+    }
+
+    fn campaign_of(&self, (name, spec, executor, created_at, updated_at): CampaignRow) -> Result<Campaign, StoreError> {
+        let executor = match executor {
+            Some(text) => Some(self.decode_json(&text, &format!("executor of campaign {name:?}"))?),
+            None => None,
+        };
+        Ok(Campaign { name, spec, executor, created_at, updated_at })
+    }
+
+    /// Records the executor the campaign's jobs are handed to (None: this machine's workers).
+    pub async fn set_executor(&self, name: &str, executor: Option<&Value>) -> Result<(), StoreError> {
+        let executor = executor.map(|e| self.encode_json(e, &format!("executor of campaign {name:?}"))).transpose()?;
+        if self.changed(sqlx::query(sql::SET_EXECUTOR).bind(name).bind(executor)).await? == 0 {
+            return Err(self.no_campaign(name));
+        }
+        Ok(())
     }
 
     /// Adds the jobs whose id is new and returns how many were; known ids are left as they are.
@@ -161,6 +174,87 @@ impl Store {
         }))
     }
 
+    /// Hands up to `count` of the campaign's pending jobs (of those in `only`, if given), in
+    /// submission order, to the workers `worker(k)` (k = 0, 1, … in the order handed) in one
+    /// transaction, and gives them.
+    pub async fn claim_many(
+        &self,
+        campaign: &str,
+        only: Option<&[String]>,
+        count: usize,
+        worker: impl Fn(usize) -> String,
+    ) -> Result<Vec<ClaimedJob>, StoreError> {
+        let only = only.map(|ids| self.encode_json(&ids, "job ids")).transpose()?;
+        let mut tx = self.pool.begin_with(sql::BEGIN_IMMEDIATE).await.map_err(self.db())?;
+        let campaign_id = self.campaign_id(&mut tx, campaign).await?;
+        let limit = i64::try_from(count).unwrap_or(i64::MAX);
+        let ids: Vec<String> = sqlx::query_scalar(sql::PENDING_JOBS)
+            .bind(campaign_id)
+            .bind(limit)
+            .bind(only)
+            .fetch_all(&mut *tx)
+            .await
+            .map_err(self.db())?;
+        let now = now();
+        let mut claimed = Vec::with_capacity(ids.len());
+        for id in ids {
+            let (id, format, spec, seed, parameters, attempts): (String, u32, String, u64, String, u32) =
+                sqlx::query_as(sql::CLAIM_JOBS)
+                    .bind(&id)
+                    .bind(campaign_id)
+                    .bind(worker(claimed.len()))
+                    .bind(now)
+                    .fetch_one(&mut *tx)
+                    .await
+                    .map_err(self.db())?;
+            claimed.push(ClaimedJob {
+                format,
+                spec: self.decode_json(&spec, &format!("spec of job {id}"))?,
+                parameters: self.decode_json(&parameters, &format!("parameters of job {id}"))?,
+                id,
+                seed,
+                attempts,
+            });
+        }
+        tx.commit().await.map_err(self.db())?;
+        Ok(claimed)
+    }
+
+    /// Hands a running job from worker `from` to worker `to`; false, changing nothing, if it is
+    /// no longer running for `from`.
+    pub async fn reassign(&self, job_id: &str, from: &str, to: &str) -> Result<bool, StoreError> {
+        Ok(self.changed(sqlx::query(sql::REASSIGN_JOB).bind(job_id).bind(from).bind(to).bind(now())).await? == 1)
+    }
+
+    /// Replaces the stored spec of a job that is not done (the same job, described anew); false,
+    /// changing nothing, for a done job.
+    pub async fn replace_spec(&self, job_id: &str, format: u32, spec: &Value) -> Result<bool, StoreError> {
+        let spec = self.encode_json(spec, &format!("spec of job {job_id}"))?;
+        Ok(self.changed(sqlx::query(sql::REPLACE_SPEC).bind(job_id).bind(format).bind(spec)).await? == 1)
+    }
+
+    /// Every job of the campaign in submission order: its stored spec and where it stands.
+    pub async fn jobs(&self, campaign: &str) -> Result<Vec<StoredJob>, StoreError> {
+        type Row = (String, u32, String, String, Option<String>, u32, Option<String>);
+        let mut conn = self.pool.acquire().await.map_err(self.db())?;
+        let campaign_id = self.campaign_id(&mut conn, campaign).await?;
+        let rows: Vec<Row> =
+            sqlx::query_as(sql::JOBS).bind(campaign_id).fetch_all(&mut *conn).await.map_err(self.db())?;
+        rows.into_iter()
+            .map(|(id, format, spec, state, worker_id, attempts, error)| {
+                Ok(StoredJob {
+                    spec: self.decode_json(&spec, &format!("spec of job {id}"))?,
+                    state: self.state(&id, &state)?,
+                    id,
+                    format,
+                    worker_id,
+                    attempts,
+                    error,
+                })
+            })
+            .collect()
+    }
+
     /// Tells the store that `worker_id` is still working on the job.
     /// Fails with [`StoreError::NotOwner`] if the job was taken away, so the worker can stop.
     pub async fn heartbeat(&self, job_id: &str, worker_id: &str) -> Result<(), StoreError> {
@@ -177,6 +271,30 @@ impl Store {
         result: &JobResult,
         statistics: &[GrainStatistic],
     ) -> Result<(), StoreError> {
+        self.finish(job_id, worker_id, None, result, statistics).await
+    }
+
+    /// [`Store::complete`] for a job that ran elsewhere from `started_at` to `finished_at`
+    /// (UNIX seconds), rather than from its claim to now.
+    pub async fn complete_ran(
+        &self,
+        job_id: &str,
+        worker_id: &str,
+        (started_at, finished_at): (f64, f64),
+        result: &JobResult,
+        statistics: &[GrainStatistic],
+    ) -> Result<(), StoreError> {
+        self.finish(job_id, worker_id, Some((started_at, finished_at)), result, statistics).await
+    }
+
+    async fn finish(
+        &self,
+        job_id: &str,
+        worker_id: &str,
+        ran: Option<(f64, f64)>,
+        result: &JobResult,
+        statistics: &[GrainStatistic],
+    ) -> Result<(), StoreError> {
         let profile = self.encode_json(&result.profile, &format!("profile of job {job_id}"))?;
         let particles = self.to_sql_int(result.particles, &format!("particles of job {job_id}"))?;
         let steps = self.to_sql_int(result.steps, &format!("steps of job {job_id}"))?;
@@ -187,7 +305,18 @@ impl Store {
             .transpose()?;
         let now = now();
         let mut tx = self.pool.begin_with(sql::BEGIN_IMMEDIATE).await.map_err(self.db())?;
-        self.update_owned(&mut *tx, sql::FINISH_JOB, job_id, worker_id, now, None).await?;
+        let finished = sqlx::query(sql::FINISH_JOB)
+            .bind(job_id)
+            .bind(worker_id)
+            .bind(ran.map_or(now, |(_, finished_at)| finished_at))
+            .bind(ran.map(|(started_at, _)| started_at))
+            .execute(&mut *tx)
+            .await
+            .map_err(self.db())?
+            .rows_affected();
+        if finished != 1 {
+            return Err(self.not_owner(job_id, worker_id));
+        }
         sqlx::query(sql::INSERT_RESULT)
             .bind(job_id)
             .bind(result.porosity)
@@ -231,14 +360,7 @@ impl Store {
     /// Ctrl-C, or the job of a worker the caller knows is gone. Its checkpoint stays, attempts
     /// keep counting. Returns false, changing nothing, if the job had already changed hands.
     pub async fn release(&self, job_id: &str, worker_id: &str) -> Result<bool, StoreError> {
-        let released = sqlx::query(sql::RELEASE_JOB)
-            .bind(job_id)
-            .bind(worker_id)
-            .execute(&self.pool)
-            .await
-            .map_err(self.db())?
-            .rows_affected();
-        Ok(released == 1)
+        Ok(self.changed(sqlx::query(sql::RELEASE_JOB).bind(job_id).bind(worker_id)).await? == 1)
     }
 
     /// The campaign's running jobs with their workers and heartbeats.
@@ -316,13 +438,7 @@ impl Store {
 
     /// Deletes the job's checkpoint; returns whether there was one.
     pub async fn delete_checkpoint(&self, job_id: &str) -> Result<bool, StoreError> {
-        let deleted = sqlx::query(sql::DELETE_CHECKPOINT)
-            .bind(job_id)
-            .execute(&self.pool)
-            .await
-            .map_err(self.db())?
-            .rows_affected();
-        Ok(deleted == 1)
+        Ok(self.changed(sqlx::query(sql::DELETE_CHECKPOINT).bind(job_id)).await? == 1)
     }
 
     /// Counts per state, the failures with their errors and the wall times, from one snapshot.
@@ -414,8 +530,7 @@ impl Store {
         jobs.into_iter()
             .map(|(job_id, state, seed, attempts, error, parameters, experiment_porosity, experiment_std, fluid)| {
                 Ok(ExportRow {
-                    state: JobState::parse(&state)
-                        .ok_or_else(|| self.invalid(format!("job {job_id} has the unknown state {state:?}")))?,
+                    state: self.state(&job_id, &state)?,
                     seed,
                     attempts,
                     error,
@@ -454,15 +569,23 @@ impl Store {
             query = query.bind(text);
         }
         let updated = query.execute(executor).await.map_err(self.db())?.rows_affected();
-        if updated == 1 {
-            Ok(())
-        } else {
-            Err(StoreError::NotOwner {
-                path: self.path.clone(),
-                job_id: job_id.to_string(),
-                worker_id: worker_id.to_string(),
-            })
-        }
+        if updated == 1 { Ok(()) } else { Err(self.not_owner(job_id, worker_id)) }
+    }
+
+    /// Runs one statement on the pool; gives how many rows it changed.
+    async fn changed(
+        &self,
+        query: sqlx::query::Query<'_, sqlx::Sqlite, sqlx::sqlite::SqliteArguments>,
+    ) -> Result<u64, StoreError> {
+        Ok(query.execute(&self.pool).await.map_err(self.db())?.rows_affected())
+    }
+
+    fn not_owner(&self, job_id: &str, worker_id: &str) -> StoreError {
+        StoreError::NotOwner { path: self.path.clone(), job_id: job_id.to_string(), worker_id: worker_id.to_string() }
+    }
+
+    fn state(&self, job_id: &str, state: &str) -> Result<JobState, StoreError> {
+        JobState::parse(state).ok_or_else(|| self.invalid(format!("job {job_id} has the unknown state {state:?}")))
     }
 
     fn db(&self) -> impl Fn(sqlx::Error) -> StoreError + '_ {
@@ -491,6 +614,9 @@ impl Store {
             .map_err(|_| self.invalid(format!("{what} = {value} exceeds 2^63 - 1, the largest SQLite integer")))
     }
 }
+
+/// name, spec, executor, created_at, updated_at
+type CampaignRow = (String, String, Option<String>, f64, f64);
 
 /// UNIX seconds from this process's clock.
 fn now() -> f64 {

@@ -13,8 +13,10 @@ pub const UPSERT_CAMPAIGN: &str = "
     INSERT INTO campaigns (name, spec, created_at, updated_at) VALUES (?1, ?2, ?3, ?3)
     ON CONFLICT (name) DO UPDATE SET spec = excluded.spec, updated_at = excluded.updated_at";
 pub const CAMPAIGN_ID: &str = "SELECT id FROM campaigns WHERE name = ?1";
-pub const CAMPAIGN: &str = "SELECT name, spec, created_at, updated_at FROM campaigns WHERE name = ?1";
-pub const CAMPAIGNS: &str = "SELECT name, spec, created_at, updated_at FROM campaigns ORDER BY created_at, name";
+pub const CAMPAIGN: &str = "SELECT name, spec, executor, created_at, updated_at FROM campaigns WHERE name = ?1";
+pub const CAMPAIGNS: &str =
+    "SELECT name, spec, executor, created_at, updated_at FROM campaigns ORDER BY created_at, name";
+pub const SET_EXECUTOR: &str = "UPDATE campaigns SET executor = ?2 WHERE name = ?1";
 
 // Jobs
 pub const INSERT_JOB: &str = "
@@ -32,11 +34,31 @@ pub const CLAIM_JOB: &str = "
     WHERE state = 'pending' AND id = (
         SELECT id FROM jobs WHERE campaign_id = ?1 AND state = 'pending' ORDER BY rowid LIMIT 1)
     RETURNING id, format, spec, seed, parameters, attempts";
+pub const CLAIM_JOBS: &str = "
+    UPDATE jobs
+    SET state = 'running', attempts = attempts + 1, worker_id = ?3,
+        started_at = ?4, heartbeat_at = ?4, finished_at = NULL, wall_time = NULL, error = NULL
+    WHERE id = ?1 AND campaign_id = ?2 AND state = 'pending'
+    RETURNING id, format, spec, seed, parameters, attempts";
+pub const PENDING_JOBS: &str = "
+    SELECT id FROM jobs
+    WHERE campaign_id = ?1 AND state = 'pending' AND (?3 IS NULL OR id IN (SELECT value FROM json_each(?3)))
+    ORDER BY rowid LIMIT ?2";
+pub const REASSIGN_JOB: &str = "
+    UPDATE jobs SET worker_id = ?3, heartbeat_at = ?4
+    WHERE id = ?1 AND worker_id = ?2 AND state = 'running'";
+pub const REPLACE_SPEC: &str = "
+    UPDATE jobs SET format = ?2, spec = ?3 WHERE id = ?1 AND state <> 'done'";
+pub const JOBS: &str = "
+    SELECT id, format, spec, state, worker_id, attempts, error FROM jobs
+    WHERE campaign_id = ?1 ORDER BY rowid";
 pub const HEARTBEAT: &str = "
     UPDATE jobs SET heartbeat_at = ?3
     WHERE id = ?1 AND worker_id = ?2 AND state = 'running'";
 pub const FINISH_JOB: &str = "
-    UPDATE jobs SET state = 'done', heartbeat_at = ?3, finished_at = ?3, wall_time = ?3 - started_at
+    UPDATE jobs
+    SET state = 'done', started_at = COALESCE(?4, started_at), heartbeat_at = ?3, finished_at = ?3,
+        wall_time = ?3 - COALESCE(?4, started_at)
     WHERE id = ?1 AND worker_id = ?2 AND state = 'running'";
 pub const FAIL_JOB: &str = "
     UPDATE jobs

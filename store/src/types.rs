@@ -31,11 +31,13 @@ impl JobState {
     }
 }
 
-/// A campaign as submitted: its name and the campaign file's text.
+/// A campaign as submitted: its name, the campaign file's text and the executor its jobs are
+/// handed to (None: the submitting machine's workers).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Campaign {
     pub name: String,
     pub spec: String,
+    pub executor: Option<Value>,
     pub created_at: f64,
     pub updated_at: f64,
 }
@@ -68,6 +70,19 @@ pub struct ClaimedJob {
     pub parameters: Map<String, Value>,
     /// How many times the job has been claimed, this time included.
     pub attempts: u32,
+}
+
+/// A stored job and where it stands.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StoredJob {
+    pub id: String,
+    pub format: u32,
+    pub spec: Value,
+    pub state: JobState,
+    /// Who runs it, or ran it last.
+    pub worker_id: Option<String>,
+    pub attempts: u32,
+    pub error: Option<String>,
 }
 
 /// What a finished packing reports.

@@ -1,5 +1,7 @@
-//! `sedpack run`, `resume`, `status` and `export`: campaigns in the SQLite store.
+//! `sedpack run`, `resume`, `cancel`, `status` and `export`: campaigns in the SQLite store, run by
+//! this machine's workers or as Slurm job arrays.
 
+use std::collections::HashMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -8,14 +10,17 @@ use analysis::csv;
 use anyhow::{Context, bail};
 use serde::Serialize;
 use serde_json::{Map, Value};
-use store::{CampaignStatus, ExportRow, NewJob, Store};
+use store::{CampaignStatus, ExportRow, NewJob, Store, StoreError, StoredJob};
+use tracing::info;
 
-use crate::campaign::read_campaign;
-use crate::cli::{ExportArgs, ResumeArgs, RunArgs, StatusArgs};
-use crate::outln;
+use crate::campaign::{Campaign, read_campaign};
+use crate::cli::{CancelArgs, ContinueArgs, ExportArgs, ResumeArgs, RunArgs, StatusArgs};
+use crate::executor::{Executor, Request};
 use crate::output::{Table, print_json};
 use crate::records::new_job;
 use crate::runner::{self, RunOptions, Summary};
+use crate::slurm::{self, Followed, RunDir, Submission, TaskRow};
+use crate::{outln, stored};
 
 pub(crate) fn runtime() -> anyhow::Result<tokio::runtime::Runtime> {
     Ok(tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?)
@@ -50,19 +55,19 @@ fn workers(requested: Option<usize>) -> anyhow::Result<usize> {
     }
 }
 
-fn report(name: &str, summary: Summary, status: &CampaignStatus) -> std::io::Result<()> {
-    outln!(
-        "{name}: {} job(s) finished now, {} failed now; campaign: {} done, {} failed, {} pending, {} running",
-        summary.completed,
-        summary.failed,
-        status.done,
-        status.failed,
-        status.pending,
-        status.running
-    )?;
+/// HEAD followed by the jobs per state ("running" named `running`), then the failures.
+fn print_states(head: &str, status: &CampaignStatus, running: &str) -> std::io::Result<()> {
+    let s = status;
+    outln!("{head}{} done, {} failed, {} pending, {} {running}", s.done, s.failed, s.pending, s.running)?;
     for f in &status.failures {
         outln!("  failed {}: {}", f.job_id, f.error)?;
     }
+    Ok(())
+}
+
+fn report(name: &str, summary: Summary, status: &CampaignStatus) -> std::io::Result<()> {
+    let head = format!("{name}: {} job(s) finished now, {} failed now; campaign: ", summary.completed, summary.failed);
+    print_states(&head, status, "running")?;
     if summary.interrupted {
         outln!("interrupted: run `sedpack resume {name}` to finish the campaign")?;
     }
@@ -78,47 +83,224 @@ fn checkpoint_interval(seconds: f64) -> anyhow::Result<Duration> {
 }
 
 pub fn run(args: &RunArgs) -> anyhow::Result<()> {
-    let options = RunOptions {
-        workers: workers(args.workers)?,
-        checkpoint_interval: checkpoint_interval(args.checkpoint_interval)?,
-    };
+    let e = &args.executor;
+    let flags = Request {
+        kind: e.executor,
+        sbatch: e.sbatch.clone(),
+        cpus_per_task: e.cpus_per_task,
+        time: e.time,
+        max_parallel: e.max_parallel,
+    }
+    .checked_flags()?;
+    let interval = checkpoint_interval(args.common.checkpoint_interval)?;
     let campaign = read_campaign(&args.campaign)?;
     let log = start_log(&args.db)?;
     runtime()?.block_on(async {
         let store = Store::open(&args.db).await?;
+        let previous = match store.campaign(&campaign.name).await {
+            Ok(c) => Some(Executor::from_stored(c.executor.as_ref())?),
+            Err(StoreError::NoCampaign { .. }) => None,
+            Err(e) => return Err(e.into()),
+        };
+        let executor = flags.over(campaign.executor.clone()).resolve(previous.as_ref());
+        check_workers(args.workers, &executor)?;
         store.upsert_campaign(&campaign.name, &campaign.text).await?;
-        let jobs: Vec<NewJob> = campaign.jobs.iter().map(new_job).collect();
-        let new = store.add_jobs(&campaign.name, &jobs).await?;
-        if args.retry_failed {
-            let retried = store.requeue_failed(&campaign.name).await?;
-            outln!("{}: {retried} failed job(s) returned to pending", campaign.name)?;
-        }
+        switch_executor(&store, &campaign.name, previous.as_ref(), &executor).await?;
+        let added = add_jobs(&store, &campaign).await?;
         outln!(
-            "{}: {} job(s), {new} new; database {}, log {}",
+            "{}: {} job(s), {} new; database {}, log {}",
             campaign.name,
-            jobs.len(),
+            campaign.jobs.len(),
+            added.new,
             args.db.display(),
             log.display()
         )?;
-        let summary = runner::run(&store, &campaign.name, &options, !args.quiet).await?;
-        report(&campaign.name, summary, &store.status(&campaign.name).await?)?;
+        if added.moved > 0 {
+            outln!(
+                "{}: {} job(s) not done now find their mesh folder where this campaign file does",
+                campaign.name,
+                added.moved
+            )?;
+        }
+        continue_campaign(&store, &args.db, &campaign.name, &executor, args.workers, &args.common, interval).await
+    })
+}
+
+fn check_workers(workers: Option<usize>, executor: &Executor) -> anyhow::Result<()> {
+    if workers.is_some() && matches!(executor, Executor::Slurm(_)) {
+        bail!("--workers applies to the local executor; a Slurm task runs one packing on --cpus-per-task threads");
+    }
+    Ok(())
+}
+
+/// Records the executor the campaign runs on from now; refuses to change it while jobs run on
+/// the other one.
+async fn switch_executor(
+    store: &Store,
+    name: &str,
+    previous: Option<&Executor>,
+    executor: &Executor,
+) -> anyhow::Result<()> {
+    let was_slurm = matches!(previous, Some(Executor::Slurm(_)));
+    let is_slurm = matches!(executor, Executor::Slurm(_));
+    if let Some(previous) = previous.filter(|_| was_slurm != is_slurm) {
+        if !was_slurm {
+            // Jobs of local runners that died are not running any more.
+            runner::recover(store, name).await?;
+        }
+        let running = store.running_jobs(name).await?.len();
+        if running > 0 {
+            let how =
+                if was_slurm { format!("wait for them or `sedpack cancel {name}`") } else { "let them end".into() };
+            bail!(
+                "{name}: {running} job(s) are running on {}: {how} before running the campaign on {executor}",
+                previous
+            );
+        }
+    }
+    store.set_executor(name, executor.to_stored().as_ref()).await?;
+    Ok(())
+}
+
+/// What submitting a campaign's jobs did.
+struct Added {
+    new: u64,
+    /// Stored jobs not done whose mesh folder moved, now described with its new place.
+    moved: usize,
+}
+
+/// Adds the campaign's new jobs. A planned job that is already stored (under its id, or, for a
+/// job of sedpack 0.1.0 with a mesh folder, under the id that version gave it) is not added
+/// again; if it is not done, its stored spec takes the mesh folder's place from the campaign file.
+async fn add_jobs(store: &Store, campaign: &Campaign) -> anyhow::Result<Added> {
+    let mut stored_by_identity: HashMap<String, StoredJob> = HashMap::new();
+    for job in store.jobs(&campaign.name).await? {
+        // A job this version cannot read is left as it is.
+        if let Ok(spec) = stored::decode(job.format, &job.spec) {
+            stored_by_identity.insert(stored::job_id(&spec), job);
+        }
+    }
+    let mut new: Vec<NewJob> = Vec::new();
+    let mut moved = 0;
+    for planned in &campaign.jobs {
+        let job = new_job(planned);
+        match stored_by_identity.get(&planned.id) {
+            None => new.push(job),
+            Some(known) if known.format == job.format && known.spec == job.spec => {}
+            Some(known) => {
+                if store.replace_spec(&known.id, job.format, &job.spec).await? {
+                    info!(job = %known.id, "stored anew: {}", job.spec["mesh_folder"]);
+                    moved += 1;
+                }
+            }
+        }
+    }
+    Ok(Added { new: store.add_jobs(&campaign.name, &new).await?, moved })
+}
+
+/// Runs or submits the campaign's pending jobs on its executor.
+async fn continue_campaign(
+    store: &Store,
+    db: &Path,
+    name: &str,
+    executor: &Executor,
+    workers_asked: Option<usize>,
+    common: &ContinueArgs,
+    checkpoint_interval: Duration,
+) -> anyhow::Result<()> {
+    let settings = match executor {
+        Executor::Slurm(settings) => settings,
+        Executor::Local => {
+            let options = RunOptions { workers: workers(workers_asked)?, checkpoint_interval };
+            retry_failed(store, name, common.retry_failed).await?;
+            let summary = runner::run(store, name, &options, !common.quiet).await?;
+            return report(name, summary, &store.status(name).await?).map_err(Into::into);
+        }
+    };
+    let run = RunDir::of(db, name)?;
+    slurm::sync(store, &run, name).await?;
+    retry_failed(store, name, common.retry_failed).await?;
+    let submission = Submission { store, run: &run, campaign: name, settings, checkpoint_interval };
+    let arrays = submission.pending(None).await?;
+    for a in &arrays {
+        outln!("{name}: submitted Slurm array {} ({} job(s))", a.array, a.jobs)?;
+    }
+    if !arrays.is_empty() {
+        outln!("{name}: run directory {}", run.path.display())?;
+    }
+    let followed = if common.wait { Some(slurm::follow(&submission, !common.quiet).await?) } else { None };
+    let status = store.status(name).await?;
+    print_states(&format!("{name}: "), &status, "in Slurm")?;
+    match followed {
+        None if status.running > 0 => {
+            outln!("follow it with `sedpack status {name}`; `sedpack resume {name} --wait` waits for it")?
+        }
+        Some(Followed::Interrupted) => outln!(
+            "stopped following; the tasks go on in Slurm: `sedpack status {name}`, `sedpack resume {name} --wait`, `sedpack cancel {name}`"
+        )?,
+        _ if status.pending > 0 => outln!("{} job(s) pending: `sedpack resume {name}` submits them", status.pending)?,
+        _ => {}
+    }
+    Ok(())
+}
+
+async fn retry_failed(store: &Store, name: &str, retry: bool) -> anyhow::Result<()> {
+    if retry {
+        let retried = store.requeue_failed(name).await?;
+        outln!("{name}: {retried} failed job(s) returned to pending")?;
+    }
+    Ok(())
+}
+
+pub fn resume(args: &ResumeArgs) -> anyhow::Result<()> {
+    let interval = checkpoint_interval(args.common.checkpoint_interval)?;
+    runtime()?.block_on(async {
+        let store = open_existing(&args.db).await?;
+        let executor = Executor::from_stored(store.campaign(&args.name).await?.executor.as_ref())?;
+        check_workers(args.workers, &executor)?;
+        start_log(&args.db)?;
+        continue_campaign(&store, &args.db, &args.name, &executor, args.workers, &args.common, interval).await
+    })
+}
+
+pub fn cancel(args: &CancelArgs) -> anyhow::Result<()> {
+    runtime()?.block_on(async {
+        let store = open_existing(&args.db).await?;
+        let name = &args.name;
+        if Executor::from_stored(store.campaign(name).await?.executor.as_ref())? == Executor::Local {
+            bail!("{name} runs on local workers, not in Slurm: stop its `sedpack run` with Ctrl-C");
+        }
+        start_log(&args.db)?;
+        let cancelled = slurm::cancel(&store, &RunDir::of(&args.db, name)?, name).await?;
+        outln!(
+            "{name}: {} job(s) pending again, their checkpoints kept (`sedpack resume {name}` continues them); \
+             {} finished meanwhile",
+            cancelled.pending,
+            cancelled.done
+        )?;
+        if !cancelled.still_ending.is_empty() {
+            outln!(
+                "tasks {} have not ended yet and keep their jobs: `sedpack cancel {name}` again later",
+                cancelled.still_ending.join(", ")
+            )?;
+        }
         Ok(())
     })
 }
 
-pub fn resume(args: &ResumeArgs) -> anyhow::Result<()> {
-    let options = RunOptions {
-        workers: workers(args.workers)?,
-        checkpoint_interval: checkpoint_interval(args.checkpoint_interval)?,
-    };
-    runtime()?.block_on(async {
-        let store = open_existing(&args.db).await?;
-        store.campaign(&args.name).await?;
-        start_log(&args.db)?;
-        let summary = runner::run(&store, &args.name, &options, !args.quiet).await?;
-        report(&args.name, summary, &store.status(&args.name).await?)?;
-        Ok(())
-    })
+/// Brings a Slurm campaign up to date before it is read; gives its executor and run directory
+/// (None for a local campaign). When Slurm cannot be asked, a warning says so and the results
+/// already in the run directory are ingested all the same.
+pub(crate) async fn catch_up(store: &Store, db: &Path, name: &str) -> anyhow::Result<Option<(Executor, RunDir)>> {
+    let executor = Executor::from_stored(store.campaign(name).await?.executor.as_ref())?;
+    if executor == Executor::Local {
+        return Ok(None);
+    }
+    let run = RunDir::of(db, name)?;
+    if let Err(e) = slurm::sync(store, &run, name).await {
+        eprintln!("sedpack: warning: {name}: {e:#}; showing what the database and the run directory hold");
+    }
+    Ok(Some((executor, run)))
 }
 
 #[derive(Serialize)]
@@ -127,11 +309,21 @@ struct StatusRecord {
     status: CampaignStatus,
     /// Pending and running jobs times the mean wall time of a finished job, for one worker (s).
     estimated_time_left: Option<f64>,
+    executor: Executor,
+    /// A Slurm campaign's jobs beside their tasks' states in Slurm.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    tasks: Option<Vec<TaskRow>>,
 }
 
-fn status_record(status: CampaignStatus) -> StatusRecord {
+async fn status_record(store: &Store, db: &Path, name: &str) -> anyhow::Result<StatusRecord> {
+    let caught_up = catch_up(store, db, name).await?;
+    let status = store.status(name).await?;
     let left = status.mean_wall_time_done.map(|m| m * (status.pending + status.running) as f64);
-    StatusRecord { status, estimated_time_left: left }
+    let (executor, tasks) = match caught_up {
+        None => (Executor::Local, None),
+        Some((executor, run)) => (executor, Some(slurm::task_rows(store, &run, name).await?)),
+    };
+    Ok(StatusRecord { status, estimated_time_left: left, executor, tasks })
 }
 
 pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
@@ -143,7 +335,7 @@ pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
         };
         let mut records = Vec::new();
         for name in &names {
-            records.push(status_record(store.status(name).await?));
+            records.push(status_record(&store, &args.db, name).await?);
         }
         if args.json {
             // One object for a named campaign, a list of every campaign otherwise.
@@ -174,6 +366,21 @@ pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
             for f in &s.failures {
                 table.row(format!("failed {}", f.job_id), f.error.clone());
             }
+            if let Some(tasks) = &r.tasks {
+                table.row("executor", r.executor.to_string());
+                for t in tasks {
+                    let reason = t.slurm_reason.as_ref().map(|r| format!(" ({r})")).unwrap_or_default();
+                    let record = t.task_record.map(|k| k.name());
+                    let slurm = match (&t.task, &t.slurm_state, record) {
+                        (Some(task), Some(state), _) => format!("task {task}: {state}{reason}"),
+                        (Some(task), None, Some(record)) => format!("task {task}: {record}, by its own record"),
+                        (Some(task), None, None) => format!("task {task}: never started"),
+                        (None, Some(state), _) => state.clone(),
+                        (None, None, _) => "not submitted".into(),
+                    };
+                    table.row(format!("job {}", t.job_id), format!("{:<8} {slurm}", t.state.as_str()));
+                }
+            }
             table.print()?;
         }
         Ok(())
@@ -183,7 +390,7 @@ pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
 pub fn export(args: &ExportArgs) -> anyhow::Result<()> {
     let rows = runtime()?.block_on(async {
         let store = open_existing(&args.db).await?;
-        store.campaign(&args.name).await?;
+        catch_up(&store, &args.db, &args.name).await?;
         Ok::<_, anyhow::Error>(store.export(&args.name).await?)
     })?;
     let mut out: Box<dyn Write> = match &args.out {

@@ -7,7 +7,7 @@ use anyhow::bail;
 use store::Store;
 
 use crate::cli::ReportArgs;
-use crate::commands::campaign::{open_existing, runtime};
+use crate::commands::campaign::{catch_up, open_existing, runtime};
 use crate::outln;
 use crate::records::{campaign_summary, job_record};
 
@@ -20,7 +20,7 @@ pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
     }
     let (status, rows) = runtime()?.block_on(async {
         let store: Store = open_existing(&args.db).await?;
-        store.campaign(&args.name).await?;
+        catch_up(&store, &args.db, &args.name).await?;
         Ok::<_, anyhow::Error>((store.status(&args.name).await?, store.export(&args.name).await?))
     })?;
     let records: Vec<JobRecord> =
