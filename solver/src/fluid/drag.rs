@@ -119,30 +119,51 @@ impl SyamlalOBrien {
     pub const SPHERES: Self = Self { curve: DallaValle };
 }
 
-/// V_r of Eqs. 6–7 for fluid fraction `fluid_fraction` and particle Reynolds number `reynolds`.
-#[inline]
-pub fn velocity_ratio(fluid_fraction: f64, reynolds: f64) -> f64 {
-    // Alone (A₁ = A₂ = 1) the ratio is 1: 0.5 (1 − r + √((1 + r)²)).
-    if fluid_fraction >= 1.0 {
-        return 1.0;
+/// The hindrance at one fluid fraction ε_f: A₁ and A₂ of Eq. 7, computed once for all the
+/// Reynolds numbers of a grain's spheres.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hindrance {
+    a1: f64,
+    a2: f64,
+}
+
+impl Hindrance {
+    /// A₁ = ε_f^4.14; A₂ = 0.8 ε_f^1.28 for ε_f ≤ 0.85, ε_f^2.65 above (Eq. 7).
+    pub fn new(fluid_fraction: f64) -> Self {
+        if fluid_fraction >= 1.0 {
+            return Self::ALONE;
+        }
+        let ln = fluid_fraction.ln();
+        let a2 = if fluid_fraction <= 0.85 { 0.8 * (1.28 * ln).exp() } else { (2.65 * ln).exp() };
+        Self { a1: (4.14 * ln).exp(), a2 }
     }
-    let ln = fluid_fraction.ln();
-    let a1 = (4.14 * ln).exp();
-    let a2 = if fluid_fraction <= 0.85 { 0.8 * (1.28 * ln).exp() } else { (2.65 * ln).exp() };
-    let r = 0.06 * reynolds;
-    0.5 * (a1 - r + (r * r + 2.0 * r * (2.0 * a2 - a1) + a1 * a1).sqrt())
+
+    /// No other grain around: ε_f = 1.
+    pub const ALONE: Self = Self { a1: 1.0, a2: 1.0 };
+
+    /// V_r of Eq. 6 at particle Reynolds number `reynolds`.
+    #[inline]
+    pub fn velocity_ratio(&self, reynolds: f64) -> f64 {
+        // Alone (A₁ = A₂ = 1) the ratio is 1: 0.5 (1 − r + √((1 + r)²)).
+        if *self == Self::ALONE {
+            return 1.0;
+        }
+        let (a1, a2) = (self.a1, self.a2);
+        let r = 0.06 * reynolds;
+        0.5 * (a1 - r + (r * r + 2.0 * r * (2.0 * a2 - a1) + a1 * a1).sqrt())
+    }
 }
 
 impl<C: DragCurve> SyamlalOBrien<C> {
-    /// Drag force on a particle of `volume` and equivalent `diameter` at `fluid_fraction`,
-    /// with `slip` = fluid velocity minus particle velocity at its centre.
+    /// Drag force on a particle of `volume` and equivalent `diameter` under `hindrance`, with
+    /// `slip` = fluid velocity minus particle velocity at its centre.
     #[inline]
     pub fn force(
         &self,
         fluid: &FluidProperties,
         diameter: f64,
         volume: f64,
-        fluid_fraction: f64,
+        hindrance: &Hindrance,
         slip: &Vector3<f64>,
     ) -> Vector3<f64> {
         let speed = slip.norm();
@@ -150,7 +171,7 @@ impl<C: DragCurve> SyamlalOBrien<C> {
             return Vector3::zeros();
         }
         let reynolds = fluid.reynolds(diameter, speed);
-        let vr = velocity_ratio(fluid_fraction, reynolds);
+        let vr = hindrance.velocity_ratio(reynolds);
         let cd = self.curve.drag_coefficient(reynolds / vr);
         slip * (volume * 0.75 * cd / (vr * vr) * fluid.density * speed / diameter)
     }
@@ -177,6 +198,10 @@ mod tests {
             let balance = DallaValle.drag_coefficient(re) * re * re / (4.0 * ar / 3.0);
             assert!((balance - 1.0).abs() < 1e-12, "Ar {ar}: {balance}");
         }
+    }
+
+    fn velocity_ratio(fluid_fraction: f64, reynolds: f64) -> f64 {
+        Hindrance::new(fluid_fraction).velocity_ratio(reynolds)
     }
 
     #[test]
@@ -206,15 +231,15 @@ mod tests {
         let d: f64 = 2e-3;
         let volume = std::f64::consts::PI * d.powi(3) / 6.0;
         let slip = Vector3::new(0.0, 0.0, 0.1);
-        let f = SyamlalOBrien::SPHERES.force(&water, d, volume, 1.0, &slip);
+        let f = SyamlalOBrien::SPHERES.force(&water, d, volume, &Hindrance::ALONE, &slip);
         let re = 1000.0 * d * 0.1 / 1e-3;
         let expected = DallaValle.drag_coefficient(re) * 0.5 * 1000.0 * 0.01 * std::f64::consts::PI * d * d / 4.0;
         assert!((f.z / expected - 1.0).abs() < 1e-12 && f.x == 0.0 && f.y == 0.0);
         // The hindrance: at ε_f < 1 the drag at w is the drag alone at w/V_r.
         let eps = 0.8;
         let vr = velocity_ratio(eps, re);
-        let hindered = SyamlalOBrien::SPHERES.force(&water, d, volume, eps, &slip);
-        let alone_at = SyamlalOBrien::SPHERES.force(&water, d, volume, 1.0, &(slip / vr));
+        let hindered = SyamlalOBrien::SPHERES.force(&water, d, volume, &Hindrance::new(eps), &slip);
+        let alone_at = SyamlalOBrien::SPHERES.force(&water, d, volume, &Hindrance::ALONE, &(slip / vr));
         assert!((hindered.z / alone_at.z - 1.0).abs() < 1e-12, "{} {}", hindered.z, alone_at.z);
     }
 

@@ -10,8 +10,9 @@
 //! surface is found where a channel profile needs it, then every body gets its fluid force and
 //! torque:
 //! - a sphere and each component sphere of a bonded grain: drag (Eqs. 3–7) and lift (Eq. 8) at
-//!   its centre, with the velocity of that point of the grain; a bonded grain's spheres are
-//!   sheltered by the wakes of its own spheres upstream ([`shielding`], sedpack's model);
+//!   its centre, with the velocity of that point of the grain and the fluid fraction at the
+//!   grain's centre of mass; a bonded grain's spheres are sheltered by the wakes of the grain's
+//!   spheres they touch upstream ([`shielding`], sedpack's model);
 //! - an ellipsoid or a polyhedron, which is not made of spheres: Haider & Levenspiel's (1989)
 //!   drag curve for its sphericity under the same hindrance, and lift as on the sphere of equal
 //!   volume, at its centre, so no torque: such a grain keeps the orientation it has.
@@ -28,7 +29,7 @@ use nalgebra::{UnitQuaternion, Vector3};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use self::drag::{FluidProperties, HaiderLevenspiel, SyamlalOBrien};
+use self::drag::{FluidProperties, HaiderLevenspiel, Hindrance, SyamlalOBrien};
 use self::flow::Flow;
 use self::fraction::{FractionGrid, Stencil};
 use self::lift::SaffmanLift;
@@ -75,16 +76,47 @@ struct Wet {
     stencil: Stencil,
 }
 
-/// The fluid stage's working memory, owned by the step pipeline: filled afresh every step.
+/// What the fluid stage keeps of a body's shape, worked out once (shapes never change).
+#[derive(Debug, Clone)]
+struct BodyShape {
+    /// Diameter of the sphere of equal volume (m).
+    diameter: f64,
+    /// The drag curve of a body not made of spheres (ellipsoid, polyhedron).
+    curve: Option<HaiderLevenspiel>,
+    /// A bonded grain's spheres that touch each other (indices within the grain): the wakes
+    /// that shelter a sphere, `touching[start[j]..start[j + 1]]` for sphere j.
+    start: Vec<u16>,
+    touching: Vec<u16>,
+}
+
+impl BodyShape {
+    fn of(shape: &Shape) -> Self {
+        let curve = matches!(shape, Shape::Ellipsoid { .. } | Shape::Polyhedron(_))
+            .then(|| HaiderLevenspiel::new(sphericity::sphericity(shape)));
+        let (mut start, mut touching) = (vec![0], Vec::new());
+        if let Shape::Bonded(b) = shape {
+            // The construction places neighbours exactly in contact; 1 % covers rounding.
+            for a in &b.spheres {
+                touching.extend(b.spheres.iter().enumerate().filter_map(|(k, c)| {
+                    let gap = (a.center - c.center).norm();
+                    (gap > 0.0 && gap <= 1.01 * (a.radius + c.radius)).then_some(k as u16)
+                }));
+                start.push(touching.len() as u16);
+            }
+        }
+        Self { diameter: 2.0 * shape.equivalent_radius(), curve, start, touching }
+    }
+}
+
+/// The fluid stage's working memory, owned by the step pipeline: filled afresh every step but
+/// for what depends on shapes alone.
 #[derive(Debug, Clone, Default)]
 pub struct Scratch {
     grid: FractionGrid,
     /// The spheres of every body, body k's at `wet[first[k]..first[k + 1]]`.
     wet: Vec<Wet>,
     first: Vec<usize>,
-    /// Per body: diameter of the sphere of equal volume and, for a body that is not made of
-    /// spheres, its drag curve (shapes never change, so this is computed once per body).
-    drag_shape: Vec<(f64, Option<HaiderLevenspiel>)>,
+    shapes: Vec<BodyShape>,
     /// Volume-equivalent spheres (height, radius) for the bed surface.
     spheres: Vec<(f64, f64)>,
     /// Height of the bed surface the profiles are measured from (m).
@@ -98,13 +130,10 @@ impl Fluid {
     pub fn apply(&self, bodies: &Bodies, domain: &Domain, density: f64, scratch: &mut Scratch) {
         let fluid = FluidProperties { density, viscosity: self.viscosity };
         let n = bodies.len();
-        for k in scratch.drag_shape.len()..n {
-            let shape = &bodies.shape[k];
-            let curve = matches!(shape, Shape::Ellipsoid { .. } | Shape::Polyhedron(_))
-                .then(|| HaiderLevenspiel::new(sphericity::sphericity(shape)));
-            scratch.drag_shape.push((2.0 * shape.equivalent_radius(), curve));
+        for k in scratch.shapes.len()..n {
+            scratch.shapes.push(BodyShape::of(&bodies.shape[k]));
         }
-        scratch.drag_shape.truncate(n);
+        scratch.shapes.truncate(n);
 
         let top = (0..n).map(|k| bodies.position[k].z + bodies.bounding_radius[k]).fold(0.0, f64::max);
         scratch.grid.reset(domain, self.cell, top);
@@ -121,13 +150,18 @@ impl Fluid {
         scratch.first.push(scratch.wet.len());
         scratch.bed = if self.flow.needs_bed() { self.bed_surface(bodies, domain, &mut scratch.spheres) } else { 0.0 };
 
-        let Scratch { grid, drag_shape, bed, wet, first, loads, .. } = scratch;
+        let Scratch { grid, shapes, bed, wet, first, loads, .. } = scratch;
         loads.resize(n, FluidLoad::default());
         loads.par_iter_mut().enumerate().for_each(|(k, load)| {
             let wet = &wet[first[k]..first[k + 1]];
-            *load = match drag_shape[k] {
-                (diameter, Some(curve)) => self.single_body(bodies, k, diameter, curve, &wet[0], grid, *bed, &fluid),
-                (_, None) => self.spheres(bodies, k, wet, grid, *bed, &fluid),
+            // The fluid fraction the other grains leave, at the centre of mass: the grid
+            // averages over cells of several grains, so one value serves all of a grain's spheres.
+            let centre = grid.stencil(&bodies.position[k]);
+            let own: f64 = wet.iter().map(|w| w.volume * w.stencil.overlap(&centre)).sum();
+            let hindrance = Hindrance::new(grid.fluid_fraction(&centre, own));
+            *load = match shapes[k].curve {
+                Some(curve) => self.single_body(bodies, k, &shapes[k], curve, &hindrance, *bed, &fluid),
+                None => self.spheres(bodies, k, wet, &shapes[k], &hindrance, *bed, &fluid),
             };
         });
     }
@@ -138,32 +172,31 @@ impl Fluid {
         &self,
         bodies: &Bodies,
         k: usize,
-        diameter: f64,
+        shape: &BodyShape,
         curve: HaiderLevenspiel,
-        wet: &Wet,
-        grid: &FractionGrid,
+        hindrance: &Hindrance,
         bed: f64,
         fluid: &FluidProperties,
     ) -> FluidLoad {
-        let x = bodies.position[k];
-        let volume = bodies.volume[k];
-        let fraction = grid.fluid_fraction(&wet.stencil, volume * wet.stencil.overlap(&wet.stencil));
-        let (velocity, vorticity) = self.flow.at(&x, bed, fluid.kinematic_viscosity());
+        let (velocity, vorticity) = self.flow.at(&bodies.position[k], bed, fluid.kinematic_viscosity());
         let slip = velocity - bodies.velocity[k];
-        let mut force = SyamlalOBrien { curve }.force(fluid, diameter, volume, fraction, &slip);
+        let d = shape.diameter;
+        let mut force = SyamlalOBrien { curve }.force(fluid, d, bodies.volume[k], hindrance, &slip);
         if self.lift {
-            force += SaffmanLift::PAPER.force(fluid, diameter, &slip, &vorticity);
+            force += SaffmanLift::PAPER.force(fluid, d, &slip, &vorticity);
         }
         FluidLoad { force, torque: Vector3::zeros() }
     }
 
     /// Drag and lift on each sphere of a sphere or bonded grain, summed at the centre of mass.
+    #[allow(clippy::too_many_arguments)]
     fn spheres(
         &self,
         bodies: &Bodies,
         k: usize,
         wet: &[Wet],
-        grid: &FractionGrid,
+        shape: &BodyShape,
+        hindrance: &Hindrance,
         bed: f64,
         fluid: &FluidProperties,
     ) -> FluidLoad {
@@ -176,20 +209,22 @@ impl Fluid {
         };
         let wake = (wet.len() > 1)
             .then(|| {
-                let mean = wet.iter().map(|w| seen(w).0 * w.volume).sum::<Vector3<f64>>() / bodies.volume[k];
-                Wake::new(&mean, nu)
+                Wake::new(&(wet.iter().map(|w| seen(w).0 * w.volume).sum::<Vector3<f64>>() / bodies.volume[k]), nu)
             })
             .flatten();
         let mut load = FluidLoad::default();
-        for w in wet {
+        for (j, w) in wet.iter().enumerate() {
             let (mut slip, vorticity) = seen(w);
             if let Some(wake) = &wake {
-                slip *= wake.shelter(&w.center, w.radius, wet.iter().map(|v| (v.center, v.radius)));
+                let touching = &shape.touching[shape.start[j] as usize..shape.start[j + 1] as usize];
+                slip *= wake.shelter(
+                    &w.center,
+                    w.radius,
+                    touching.iter().map(|&i| (wet[i as usize].center, wet[i as usize].radius)),
+                );
             }
-            let own: f64 = wet.iter().map(|v| v.volume * v.stencil.overlap(&w.stencil)).sum();
-            let fraction = grid.fluid_fraction(&w.stencil, own);
             let d = 2.0 * w.radius;
-            let mut f = SyamlalOBrien::SPHERES.force(fluid, d, w.volume, fraction, &slip);
+            let mut f = SyamlalOBrien::SPHERES.force(fluid, d, w.volume, hindrance, &slip);
             if self.lift {
                 f += SaffmanLift::PAPER.force(fluid, d, &slip, &vorticity);
             }
