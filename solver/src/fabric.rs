@@ -89,18 +89,18 @@ mod tests {
 
     #[test]
     fn grains_leaning_against_the_flow_dip_upstream() {
-        // Long axis (body x) turned 20° about +y: its +x end rises, so the end pointing down is
-        // −x, the upstream side: dip 20°, direction 180°.
-        let lean = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), -20f64.to_radians());
+        // Long axis (body x) turned 25° about +y: its +x end rises, so the end pointing down is
+        // −x, the upstream side: dip 25° (mid-class: 20° would sit on a class edge), direction 180°.
+        let lean = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), -25f64.to_radians());
         let f = imbrication(&[rod(), rod()], &[lean, lean]).unwrap();
         assert_eq!(f.grains, 2);
-        assert!((f.mean_dip - 20.0).abs() < 1e-9);
+        assert!((f.mean_dip - 25.0).abs() < 1e-9);
         assert_eq!(f.dip[2], 1.0);
         assert_eq!(f.direction[6], 1.0);
         assert_eq!(f.upstream, 1.0);
         assert!((f.resultant_direction.abs() - 180.0).abs() < 1e-9 && (f.resultant_length - 1.0).abs() < 1e-12);
         // Mirrored grains cancel in the resultant; a sphere has no long axis.
-        let other = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), 20f64.to_radians());
+        let other = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), 25f64.to_radians());
         let both = imbrication(&[rod(), rod(), Shape::Sphere { radius: 1.0 }], &[lean, other, lean]).unwrap();
         assert_eq!((both.grains, both.upstream), (2, 0.5));
         assert!(both.resultant_length < 1e-12);
