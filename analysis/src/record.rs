@@ -1,10 +1,11 @@
 //! What the analysis reads: one plain record per finished job and a campaign summary. The
 //! pipeline maps store rows into these; the analysis never sees SQLite types, and of the solver
-//! only the porosity profile's points.
+//! only the porosity profile's points and the imbrication.
 
 use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
+use solver::fabric::Imbrication;
 use solver::porosity::ProfilePoint;
 
 /// A measured porosity to compare the simulated one with (Table 6).
@@ -28,6 +29,11 @@ pub struct JobRecord {
     pub grain_statistics: BTreeMap<String, (f64, f64)>,
     /// Measured porosity, when the campaign gives one.
     pub experiment: Option<Experiment>,
+    /// The fluid forces the packing was deposited with, in words ("drag, still water"); None:
+    /// buoyancy only, the first paper's protocol.
+    pub fluid: Option<String>,
+    /// The long axes' fabric against the flow, for packings that report one.
+    pub imbrication: Option<Imbrication>,
 }
 
 /// The campaign as a whole, for the report header.

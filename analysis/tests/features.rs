@@ -15,6 +15,8 @@ fn record(id: &str, porosity: f64, grains: &[(f64, f64)]) -> JobRecord {
         parameters: BTreeMap::new(),
         grain_statistics: grain_statistics(grains),
         experiment: None,
+        fluid: None,
+        imbrication: None,
     }
 }
 

@@ -70,6 +70,8 @@ fn mixture_campaign() -> Vec<JobRecord> {
                         ]),
                         grain_statistics: stats,
                         experiment: None,
+                        fluid: None,
+                        imbrication: None,
                     });
                 }
             }
@@ -236,6 +238,8 @@ fn validation_campaign() -> Vec<JobRecord> {
                 parameters: BTreeMap::from([("grains.size".into(), json!(case)), ("seed".into(), json!(seed + 1))]),
                 grain_statistics: grain_statistics(&[(fl, el); 3]),
                 experiment: Some(experiment),
+                fluid: None,
+                imbrication: None,
             });
         }
     }
@@ -328,6 +332,8 @@ fn a_campaign_over_grain_shapes_compares_them_at_equal_form() {
                 ]),
                 grain_statistics: grain_statistics(&[(form, form); 3]),
                 experiment: None,
+                fluid: None,
+                imbrication: None,
             });
         }
     }

@@ -45,10 +45,52 @@ pub enum Command {
     /// Particle-steps per second of the DEM engine on standard settled beds, per shape and
     /// thread count: how to size a campaign.
     Bench(BenchArgs),
+    /// Terminal settling velocity of one grain in still water (the second paper's drag and lift),
+    /// beside Haider & Levenspiel's and Dietrich's correlations.
+    Settle(SettleArgs),
     /// Run one job of a Slurm campaign in its folder of the run directory (what each Slurm task
     /// runs; never opens the database).
     #[command(hide = true)]
     Task(TaskArgs),
+}
+
+/// The grain shapes `sedpack settle` drops.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SettleShape {
+    Sphere,
+    Ellipsoid,
+    Mesh,
+    BondedSpheres,
+}
+
+#[derive(Debug, Args)]
+#[command(group(ArgGroup::new("grain").required(true).args(["lis", "d"])))]
+pub struct SettleArgs {
+    /// Long, intermediate and short axes of the grain (m), L ≥ I ≥ S > 0.
+    #[arg(long, num_args = 3, value_names = ["L", "I", "S"], allow_negative_numbers = true)]
+    pub lis: Option<Vec<f64>>,
+    /// Diameter of a sphere (m).
+    #[arg(long, allow_negative_numbers = true)]
+    pub d: Option<f64>,
+    /// With --lis: ellipsoid (default), bonded-spheres (Sun & Xiao's grain for L, I, S) or mesh
+    /// (the first Rhine scan stretched to L, I, S); --d drops a sphere.
+    #[arg(long, value_enum)]
+    pub shape: Option<SettleShape>,
+    /// Grain density ρ_s (kg/m³).
+    #[arg(long, default_value_t = 2650.0, allow_negative_numbers = true)]
+    pub density: f64,
+    /// Fluid density ρ_f (kg/m³); default: the papers' water.
+    #[arg(long, default_value_t = solver::fluid::WATER.density, allow_negative_numbers = true)]
+    pub fluid_density: f64,
+    /// Dynamic viscosity μ (Pa·s); default: water at 20 °C.
+    #[arg(long, default_value_t = solver::fluid::WATER.viscosity, allow_negative_numbers = true)]
+    pub viscosity: f64,
+    /// Powers' roundness P for Dietrich's correlation (6 perfectly round … 2 angular); default
+    /// 6 for the smooth shapes, 3.5 (natural grains) for the mesh.
+    #[arg(long, allow_negative_numbers = true)]
+    pub roundness: Option<f64>,
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// A shape of `sedpack bench`, or all of them.

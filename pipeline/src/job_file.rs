@@ -21,6 +21,7 @@ pub struct JobFile {
     pub evaluation: Option<EvaluationFile>,
     pub experiment: Option<ExperimentFile>,
     pub seed: Option<u64>,
+    pub fluid: Option<FluidFile>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -109,6 +110,48 @@ pub struct ProcessFile {
     pub shaking: Option<ShakingFile>,
     pub damping: Option<f64>,
     pub convergence: Option<ConvergenceFile>,
+    pub fluid: Option<ProcessFluidFile>,
+}
+
+/// Which fluid forces act during the protocol.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ProcessFluidFile {
+    /// Buoyancy only, the first paper's protocol (default).
+    None,
+    /// Drag (Sun & Xiao Eqs. 3–7) and lift (Eq. 8) in the flow of the `fluid:` block.
+    Drag,
+}
+
+/// The fluid: its density (buoyancy's too), viscosity, prescribed flow, lift and averaging.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FluidFile {
+    pub density: Option<f64>,
+    pub viscosity: Option<f64>,
+    pub flow: Option<FlowFile>,
+    pub lift: Option<bool>,
+    pub cell: Option<Auto>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FlowKindFile {
+    Quiescent,
+    Uniform,
+    Laminar,
+    Logarithmic,
+}
+
+/// A prescribed flow: its kind and the keys that kind takes.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FlowFile {
+    pub kind: Option<FlowKindFile>,
+    pub velocity: Option<[f64; 3]>,
+    pub shear_velocity: Option<f64>,
+    pub depth: Option<f64>,
+    pub roughness: Option<f64>,
 }
 
 #[derive(Debug, Default, Deserialize)]

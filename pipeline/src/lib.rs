@@ -35,6 +35,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Export(args) => commands::campaign::export(&args),
         Command::Report(args) => commands::report::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
+        Command::Settle(args) => commands::settle::run(&args),
         Command::Task(args) => slurm::task::run(&args),
     }
 }

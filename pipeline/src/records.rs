@@ -6,7 +6,10 @@ use std::collections::BTreeMap;
 
 use analysis::{CampaignSummary, Experiment, JobRecord};
 use anyhow::Context;
-use solver::packing::PackingResult;
+use serde::{Deserialize, Serialize};
+use solver::fabric::Imbrication;
+use solver::fluid::flow::Flow;
+use solver::packing::{PackingResult, PackingSpec};
 use solver::porosity::ProfilePoint;
 use store::{CampaignStatus, ExportRow, GrainStatistic, JobResult, NewJob};
 
@@ -19,12 +22,69 @@ pub fn new_job(job: &PlannedJob) -> NewJob {
     let experiment = job.spec.experiment;
     NewJob {
         id: job.id.clone(),
-        format: stored::FORMAT,
+        format: stored::format(&job.spec),
         spec: stored::encode(&job.spec),
         seed: job.spec.packing.seed,
         parameters: job.parameters.clone(),
         experiment_porosity: experiment.map(|e| e.porosity),
         experiment_std: experiment.and_then(|e| e.std),
+        fluid: FluidColumn::of(&job.spec.packing).map(|f| serde_json::to_value(f).expect("numbers and words")),
+    }
+}
+
+/// The jobs table's `fluid` column: the fluid forces of a job, as later stages read them.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct FluidColumn {
+    /// kg/m³ and Pa·s.
+    density: f64,
+    viscosity: f64,
+    flow: FlowColumn,
+    lift: bool,
+    /// m.
+    cell: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+enum FlowColumn {
+    Quiescent,
+    Uniform { velocity: [f64; 3] },
+    Laminar { shear_velocity: f64, depth: f64 },
+    Logarithmic { shear_velocity: f64, roughness: f64 },
+}
+
+impl FluidColumn {
+    fn of(spec: &PackingSpec) -> Option<Self> {
+        let f = spec.fluid?;
+        Some(Self {
+            density: spec.material.fluid_density,
+            viscosity: f.viscosity,
+            flow: match f.flow {
+                Flow::Quiescent => FlowColumn::Quiescent,
+                Flow::Uniform { velocity } => FlowColumn::Uniform { velocity: velocity.into() },
+                Flow::Laminar { shear_velocity, depth } => FlowColumn::Laminar { shear_velocity, depth },
+                Flow::Logarithmic { shear_velocity, roughness } => {
+                    FlowColumn::Logarithmic { shear_velocity, roughness }
+                }
+            },
+            lift: f.lift,
+            cell: spec.derived().fluid_cell,
+        })
+    }
+
+    /// The fluid in words, for the report.
+    fn describe(&self) -> String {
+        let flow = match &self.flow {
+            FlowColumn::Quiescent => "still water".to_string(),
+            FlowColumn::Uniform { velocity: [u, v, w] } => format!("uniform flow ({u}, {v}, {w}) m/s"),
+            FlowColumn::Laminar { shear_velocity, depth } => {
+                format!("laminar channel, u* = {shear_velocity} m/s, depth {depth} m")
+            }
+            FlowColumn::Logarithmic { shear_velocity, roughness } => {
+                format!("logarithmic current, u* = {shear_velocity} m/s, z₀ = {roughness} m")
+            }
+        };
+        format!("drag{}, {flow}", if self.lift { " and lift" } else { "" })
     }
 }
 
@@ -41,6 +101,7 @@ pub fn result_rows(result: &PackingResult) -> (JobResult, Vec<GrainStatistic>) {
         steps: result.steps,
         wall_time: result.wall_time.as_secs_f64(),
         solver_version: solver::VERSION.to_string(),
+        imbrication: result.imbrication.as_ref().map(|i| serde_json::to_value(i).expect("numbers")),
     };
     let statistics = result
         .statistics
@@ -55,6 +116,18 @@ pub fn job_record(row: &ExportRow) -> anyhow::Result<Option<JobRecord>> {
     let Some(result) = &row.result else { return Ok(None) };
     let profile: Vec<ProfilePoint> = serde_json::from_value(result.profile.clone())
         .with_context(|| format!("job {}: the stored porosity profile is not [{{z, n}}, …]", row.job_id))?;
+    let fluid: Option<FluidColumn> = row
+        .fluid
+        .clone()
+        .map(serde_json::from_value)
+        .transpose()
+        .with_context(|| format!("job {}: the stored fluid is not sedpack's", row.job_id))?;
+    let imbrication: Option<Imbrication> = result
+        .imbrication
+        .clone()
+        .map(serde_json::from_value)
+        .transpose()
+        .with_context(|| format!("job {}: the stored imbrication is not sedpack's", row.job_id))?;
     Ok(Some(JobRecord {
         job_id: row.job_id.clone(),
         porosity: result.porosity,
@@ -66,6 +139,8 @@ pub fn job_record(row: &ExportRow) -> anyhow::Result<Option<JobRecord>> {
             .map(|s| (s.name.clone(), (s.mean, s.std)))
             .collect::<BTreeMap<_, _>>(),
         experiment: row.experiment_porosity.map(|porosity| Experiment { porosity, std: row.experiment_std }),
+        fluid: fluid.map(|f| f.describe()),
+        imbrication,
     }))
 }
 
@@ -98,6 +173,7 @@ mod tests {
             parameters: serde_json::Map::new(),
             experiment_porosity: Some(0.4),
             experiment_std: None,
+            fluid: None,
             result: Some(JobResult {
                 porosity: 0.38,
                 z_minus: 0.003,
@@ -108,6 +184,7 @@ mod tests {
                 steps: 60_000,
                 wall_time: 1.0,
                 solver_version: "0.1.0".into(),
+                imbrication: None,
             }),
             grain_statistics: vec![GrainStatistic { name: "FL".into(), mean: 0.6, std: 0.05 }],
         }
@@ -123,5 +200,22 @@ mod tests {
         assert!(error.contains("job j1") && error.contains("porosity profile"), "{error}");
         let pending = ExportRow { result: None, ..row(json!([])) };
         assert_eq!(job_record(&pending).unwrap(), None);
+    }
+
+    #[test]
+    fn a_jobs_fluid_is_written_at_submission_and_read_back_in_words() {
+        use solver::packing::{DomainKind, FluidSpec};
+        let mut spec = PackingSpec::paper(DomainKind::Periodic);
+        assert_eq!(FluidColumn::of(&spec), None);
+        spec.fluid = Some(FluidSpec {
+            flow: Flow::Logarithmic { shear_velocity: 0.05, roughness: 2e-4 },
+            ..FluidSpec::STILL_WATER
+        });
+        let column = serde_json::to_value(FluidColumn::of(&spec).unwrap()).unwrap();
+        assert_eq!(column["flow"], json!({"kind": "logarithmic", "shear_velocity": 0.05, "roughness": 2e-4}));
+        let record = job_record(&ExportRow { fluid: Some(column), ..row(json!([])) }).unwrap().unwrap();
+        assert_eq!(record.fluid.as_deref(), Some("drag and lift, logarithmic current, u* = 0.05 m/s, z₀ = 0.0002 m"));
+        let error = job_record(&ExportRow { fluid: Some(json!({"flow": 1})), ..row(json!([])) }).unwrap_err();
+        assert!(error.to_string().contains("stored fluid"), "{error}");
     }
 }

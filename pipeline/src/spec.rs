@@ -7,13 +7,15 @@ use std::path::Path;
 use analysis::Experiment;
 use nalgebra::Vector3;
 use solver::dem::{Calibration, Domain, Material};
+use solver::fluid::flow::Flow;
 use solver::grain::simplify::DEFAULT_MAX_FACES;
 use solver::grain::{FormDistribution, SieveCurve, Table3Case};
-use solver::packing::{DomainKind, FormSpec, PackingSpec, Process, ShapeKind, SpecError, in_range};
+use solver::packing::{DomainKind, FluidSpec, FormSpec, PackingSpec, Process, ShapeKind, SpecError, in_range};
 
 use crate::job_file::{
-    CalibrationFile, DomainFile, DomainKindFile, EvaluationFile, ExperimentFile, FormFile, GrainsFile, JobFile,
-    MaterialFile, ProcessFile, ShapeFile, SizeFile, SolverFile, Source, read_job_file,
+    CalibrationFile, DomainFile, DomainKindFile, EvaluationFile, ExperimentFile, FlowFile, FlowKindFile, FluidFile,
+    FormFile, GrainsFile, JobFile, MaterialFile, ProcessFile, ProcessFluidFile, ShapeFile, SizeFile, SolverFile,
+    Source, read_job_file,
 };
 use crate::meshes;
 
@@ -45,9 +47,14 @@ pub fn resolve(file: JobFile, source: &Source) -> anyhow::Result<JobSpec> {
     let mut packing = PackingSpec::paper(kind);
     domain(d, &mut packing);
     grains(file.grains.unwrap_or_default(), &mut packing, source)?;
-    material(file.material.unwrap_or_default(), &mut packing.material);
+    let m = file.material.unwrap_or_default();
+    let fluid_density_given = m.fluid_density.is_some();
+    material(m, &mut packing.material);
     solver(file.solver.unwrap_or_default(), &mut packing);
-    process(file.process.unwrap_or_default(), &mut packing.process);
+    let p = file.process.unwrap_or_default();
+    let drag = p.fluid == Some(ProcessFluidFile::Drag);
+    process(p, &mut packing.process);
+    fluid(file.fluid.unwrap_or_default(), drag, fluid_density_given, &mut packing, source)?;
     evaluation(file.evaluation.unwrap_or_default(), &mut packing);
     packing.seed = file.seed.unwrap_or(packing.seed);
     packing.check().map_err(|e| spec_error(source, e))?;
@@ -162,6 +169,88 @@ fn process(p: ProcessFile, process: &mut Process) {
     let convergence = p.convergence.unwrap_or_default();
     set(&mut process.height_change, convergence.height_change);
     set(&mut process.interval, convergence.interval);
+}
+
+/// The fluid: its density is buoyancy's whether or not drag is on (`material.fluid_density`
+/// names the same value, so only one of the two may be given); the rest applies with
+/// `process.fluid: drag`, which turns on drag and lift in still water at 20 °C unless the block
+/// says otherwise.
+fn fluid(f: FluidFile, drag: bool, density_given: bool, spec: &mut PackingSpec, source: &Source) -> anyhow::Result<()> {
+    if let Some(density) = f.density {
+        if density_given {
+            return Err(source.error(
+                "fluid.density",
+                "the fluid's density is given twice: keep fluid.density or material.fluid_density",
+            ));
+        }
+        let grain = spec.material.density;
+        in_range(
+            "fluid.density",
+            density,
+            density >= 0.0 && density < grain,
+            "≥ 0 and below material.density (grains must sink)",
+        )
+        .map_err(|e| spec_error(source, e))?;
+        spec.material.fluid_density = density;
+    }
+    if !drag {
+        let given = [
+            ("fluid.viscosity", f.viscosity.is_some()),
+            ("fluid.flow", f.flow.is_some()),
+            ("fluid.lift", f.lift.is_some()),
+            ("fluid.cell", f.cell.is_some()),
+        ];
+        return match given.iter().find(|(_, given)| *given) {
+            Some((key, _)) => Err(source.error(key, "applies with process.fluid: drag only")),
+            None => Ok(()),
+        };
+    }
+    let mut fluid = FluidSpec::STILL_WATER;
+    set(&mut fluid.viscosity, f.viscosity);
+    set(&mut fluid.lift, f.lift);
+    fluid.cell = f.cell.and_then(|c| c.given());
+    if let Some(flow) = f.flow {
+        fluid.flow = flow_of(flow, source)?;
+    }
+    spec.fluid = Some(fluid);
+    Ok(())
+}
+
+/// A flow of the kind the file names, with the keys that kind takes and no other.
+fn flow_of(f: FlowFile, source: &Source) -> anyhow::Result<Flow> {
+    let kind = f
+        .kind
+        .ok_or_else(|| source.error("fluid.flow.kind", "required: quiescent, uniform, laminar or logarithmic"))?;
+    let (name, takes): (&str, &[&str]) = match kind {
+        FlowKindFile::Quiescent => ("quiescent", &[]),
+        FlowKindFile::Uniform => ("uniform", &["velocity"]),
+        FlowKindFile::Laminar => ("laminar", &["shear_velocity", "depth"]),
+        FlowKindFile::Logarithmic => ("logarithmic", &["shear_velocity", "roughness"]),
+    };
+    let keys = [
+        ("velocity", f.velocity.is_some()),
+        ("shear_velocity", f.shear_velocity.is_some()),
+        ("depth", f.depth.is_some()),
+        ("roughness", f.roughness.is_some()),
+    ];
+    for (key, given) in keys {
+        let wanted = takes.contains(&key);
+        if given && !wanted {
+            return Err(source.error(&format!("fluid.flow.{key}"), format!("does not apply to kind {name}")));
+        }
+        if wanted && !given {
+            return Err(source.error(&format!("fluid.flow.{key}"), format!("required for kind {name}")));
+        }
+    }
+    let value = |v: Option<f64>| v.expect("checked above");
+    Ok(match kind {
+        FlowKindFile::Quiescent => Flow::Quiescent,
+        FlowKindFile::Uniform => Flow::Uniform { velocity: Vector3::from(f.velocity.expect("checked above")) },
+        FlowKindFile::Laminar => Flow::Laminar { shear_velocity: value(f.shear_velocity), depth: value(f.depth) },
+        FlowKindFile::Logarithmic => {
+            Flow::Logarithmic { shear_velocity: value(f.shear_velocity), roughness: value(f.roughness) }
+        }
+    })
 }
 
 fn evaluation(e: EvaluationFile, spec: &mut PackingSpec) {

@@ -10,6 +10,10 @@
 //!   format 1's JSON with a mesh folder named `folder` (its digest pins the meshes); the folder's
 //!   place is `mesh_folder`, outside the id. IDENTITY is byte for byte format 1's JSON for every
 //!   job without a mesh folder, so those ids are 0.1.0's.
+//! - Format 3 is format 2 whose identity has fluid forces (`packing.fluid`), which formats 1 and
+//!   2 have not: a job without them is still written in format 2, the same bytes and id as
+//!   before, and a version that knows only formats 1 and 2 refuses a job with them instead of
+//!   running it without.
 //!
 //! A stored format is frozen: a release that adds a field writes a new format with its own types
 //! beside these, keeps reading every older one (giving the new field the value that reproduces
@@ -19,14 +23,20 @@ use anyhow::{Context, bail};
 use nalgebra::Vector3;
 use sha2::{Digest, Sha256};
 use solver::dem::{Calibration, Domain, Material, Shaking};
+use solver::fluid::flow::Flow;
 use solver::grain::{FormDistribution, MeshLibrary, SieveCurve, Table3Case};
-use solver::packing::{FormSpec, GrainSpec, PackingSpec, Process, ShapeKind};
+use solver::packing::{FluidSpec, FormSpec, GrainSpec, PackingSpec, Process, ShapeKind};
 
 use crate::meshes;
 use crate::spec::JobSpec;
 
-/// The format this version writes.
-pub const FORMAT: u32 = 2;
+/// The newest format this version reads and writes.
+pub const FORMAT: u32 = 3;
+
+/// The format a job is written in: the oldest of this version's that holds it.
+pub fn format(job: &JobSpec) -> u32 {
+    if job.packing.fluid.is_some() { 3 } else { 2 }
+}
 /// A mesh folder's name in a format 2 identity.
 const FOLDER: &str = "folder";
 
@@ -56,6 +66,25 @@ mod v1 {
         pub(super) cutoff: f64,
         pub(super) trim: Option<f64>,
         pub(super) seed: u64,
+        /// Format 3 only; absent, it leaves the bytes of formats 1 and 2 as they were.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub(super) fluid: Option<Fluid>,
+    }
+
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    pub(super) struct Fluid {
+        pub(super) viscosity: f64,
+        pub(super) flow: Flow,
+        pub(super) lift: bool,
+        pub(super) cell: f64,
+    }
+
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    pub(super) enum Flow {
+        Quiescent,
+        Uniform { velocity: [f64; 3] },
+        Laminar { shear_velocity: f64, depth: f64 },
+        Logarithmic { shear_velocity: f64, roughness: f64 },
     }
 
     #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -153,7 +182,7 @@ mod v1 {
     }
 }
 
-/// Format 2: format 1's job with the place of its mesh folder taken out of it.
+/// Formats 2 and 3: format 1's job with the place of its mesh folder taken out of it.
 mod v2 {
     use serde::{Deserialize, Serialize};
 
@@ -167,7 +196,7 @@ mod v2 {
     }
 }
 
-/// The stored JSON of a job, in format [`FORMAT`].
+/// The stored JSON of a job, in its [`format`].
 pub fn encode(job: &JobSpec) -> serde_json::Value {
     let mesh_folder = job.packing.grains.meshes.as_ref().map(|m| m.source.clone()).filter(|s| !meshes::is_builtin(s));
     serde_json::to_value(v2::Job { job: identity(job), mesh_folder })
@@ -189,11 +218,11 @@ pub fn job_id(job: &JobSpec) -> String {
 /// The job a stored JSON of the given format describes. Its meshes, if any, are only named: the
 /// caller loads them again.
 pub fn decode(format: u32, json: &serde_json::Value) -> anyhow::Result<JobSpec> {
-    match format {
-        1 => from_v1(serde_json::from_value(json.clone()).context("the stored job is not format 1")?),
-        2 => {
-            let v2::Job { mut job, mesh_folder } =
-                serde_json::from_value(json.clone()).context("the stored job is not format 2")?;
+    let job = match format {
+        1 => serde_json::from_value(json.clone()).context("the stored job is not format 1")?,
+        2 | 3 => {
+            let v2::Job { mut job, mesh_folder } = serde_json::from_value(json.clone())
+                .with_context(|| format!("the stored job is not format {format}"))?;
             let named = job.packing.grains.meshes.as_mut().map(|m| &mut m.source);
             match (named, mesh_folder) {
                 (Some(source), Some(folder)) if source == FOLDER => *source = folder,
@@ -204,13 +233,17 @@ pub fn decode(format: u32, json: &serde_json::Value) -> anyhow::Result<JobSpec> 
                      names a builtin library without a folder, or `{FOLDER}` with one"
                 ),
             }
-            from_v1(job)
+            job
         }
         _ => bail!(
             "the job is stored in format {format}, which this version of sedpack (formats 1 to {FORMAT}) \
              cannot read: a newer sedpack stored it"
         ),
+    };
+    if job.packing.fluid.is_some() != (format == 3) {
+        bail!("the stored job is not format {format}: format 3 is the one with fluid forces");
     }
+    from_v1(job)
 }
 
 fn from_v1(job: v1::Job) -> anyhow::Result<JobSpec> {
@@ -290,6 +323,17 @@ fn from_v1(job: v1::Job) -> anyhow::Result<JobSpec> {
         cutoff: p.cutoff,
         trim: p.trim,
         seed: p.seed,
+        fluid: p.fluid.map(|f| FluidSpec {
+            viscosity: f.viscosity,
+            flow: match f.flow {
+                v1::Flow::Quiescent => Flow::Quiescent,
+                v1::Flow::Uniform { velocity } => Flow::Uniform { velocity: Vector3::from(velocity) },
+                v1::Flow::Laminar { shear_velocity, depth } => Flow::Laminar { shear_velocity, depth },
+                v1::Flow::Logarithmic { shear_velocity, roughness } => Flow::Logarithmic { shear_velocity, roughness },
+            },
+            lift: f.lift,
+            cell: Some(f.cell),
+        }),
     };
     packing.check().context("the stored job")?;
     let experiment = job.experiment.map(|e| analysis::Experiment { porosity: e.porosity, std: e.std });
@@ -365,6 +409,19 @@ fn identity(job: &JobSpec) -> v1::Job {
             cutoff: spec.cutoff,
             trim: spec.trim,
             seed: spec.seed,
+            fluid: spec.fluid.map(|f| v1::Fluid {
+                viscosity: f.viscosity,
+                flow: match f.flow {
+                    Flow::Quiescent => v1::Flow::Quiescent,
+                    Flow::Uniform { velocity } => v1::Flow::Uniform { velocity: velocity.into() },
+                    Flow::Laminar { shear_velocity, depth } => v1::Flow::Laminar { shear_velocity, depth },
+                    Flow::Logarithmic { shear_velocity, roughness } => {
+                        v1::Flow::Logarithmic { shear_velocity, roughness }
+                    }
+                },
+                lift: f.lift,
+                cell: derived.fluid_cell,
+            }),
         },
         experiment: job.experiment.map(|e| v1::Experiment { porosity: e.porosity, std: e.std }),
     }
@@ -398,7 +455,7 @@ mod tests {
         cylinder.trim = Some(0.002);
         for spec in [PackingSpec::paper(DomainKind::Periodic), cylinder] {
             let original = job(spec);
-            let back = decode(FORMAT, &encode(&original)).unwrap();
+            let back = decode(format(&original), &encode(&original)).unwrap();
             assert_eq!(back.packing.derived(), original.packing.derived());
             assert_eq!(back.packing.height, Some(original.packing.derived().height));
             assert_eq!((back.name.as_str(), back.experiment), ("j", original.experiment));
@@ -424,7 +481,7 @@ mod tests {
         let stored = encode(&there);
         assert_eq!(stored["job"]["packing"]["grains"]["meshes"]["source"], "folder");
         assert_eq!(stored["mesh_folder"], "/scratch/me/scans");
-        let back = decode(FORMAT, &stored).unwrap();
+        let back = decode(2, &stored).unwrap();
         assert_eq!(back.packing.grains.meshes.unwrap().source, "/scratch/me/scans");
         // Another digest is another job.
         let mut other = folder_job("/data/scans");
@@ -440,27 +497,54 @@ mod tests {
     }
 
     #[test]
+    fn a_job_with_fluid_forces_is_format_3_and_reads_back_with_its_cell_concrete() {
+        let mut spec = PackingSpec::paper(DomainKind::Periodic);
+        spec.fluid = Some(FluidSpec {
+            flow: Flow::Logarithmic { shear_velocity: 0.05, roughness: 2e-4 },
+            ..FluidSpec::STILL_WATER
+        });
+        let original = job(spec);
+        assert_eq!(format(&original), 3);
+        let stored = encode(&original);
+        assert_eq!(stored["job"]["packing"]["fluid"]["cell"], serde_json::json!(original.packing.derived().fluid_cell));
+        let back = decode(3, &stored).unwrap();
+        assert_eq!(back.packing.fluid.map(|f| f.flow), original.packing.fluid.map(|f| f.flow));
+        assert_eq!(canonical_json(&back), canonical_json(&original));
+        for older in [1, 2] {
+            let json = if older == 1 { stored["job"].clone() } else { stored.clone() };
+            let error = decode(older, &json).unwrap_err().to_string();
+            assert!(error.contains("format 3 is the one with fluid forces"), "{error}");
+        }
+        // Without fluid forces the identity has no `fluid` key: format 1's bytes, format 2's id.
+        let plain = job(PackingSpec::paper(DomainKind::Periodic));
+        assert_eq!(format(&plain), 2);
+        assert!(encode(&plain)["job"]["packing"].get("fluid").is_none());
+    }
+
+    #[test]
     fn stored_jobs_that_disagree_with_themselves_or_another_format_are_refused() {
         let stored = encode(&job(PackingSpec::paper(DomainKind::Periodic)));
-        let error = decode(3, &stored).unwrap_err().to_string();
-        assert!(error.contains("format 3") && error.contains("formats 1 to 2"), "{error}");
+        let error = decode(4, &stored).unwrap_err().to_string();
+        assert!(error.contains("format 4") && error.contains("formats 1 to 3"), "{error}");
         let error = format!("{:#}", decode(1, &stored).unwrap_err());
         assert!(error.contains("not format 1"), "{error}");
+        let error = decode(3, &stored).unwrap_err().to_string();
+        assert!(error.contains("fluid forces"), "{error}");
         let mut two_steps = stored.clone();
         two_steps["job"]["packing"]["calibration"]["Discrete"]["time_step"] = serde_json::json!(1e-5);
-        let error = decode(FORMAT, &two_steps).unwrap_err().to_string();
+        let error = decode(2, &two_steps).unwrap_err().to_string();
         assert!(error.contains("1e-5") || error.contains("0.00001"), "{error}");
         let mut renamed = stored.clone();
         renamed["job"]["size_case"] = serde_json::json!("U7");
-        let error = decode(FORMAT, &renamed).unwrap_err().to_string();
+        let error = decode(2, &renamed).unwrap_err().to_string();
         assert!(error.contains("size case U7"), "{error}");
         // A folder without its place, or a place without a folder.
         let mut placeless = encode(&folder_job("/data/scans"));
         placeless["mesh_folder"] = serde_json::Value::Null;
-        let error = decode(FORMAT, &placeless).unwrap_err().to_string();
+        let error = decode(2, &placeless).unwrap_err().to_string();
         assert!(error.contains("\"folder\"") && error.contains("None"), "{error}");
         let mut stray = stored;
         stray["mesh_folder"] = "/data/scans".into();
-        assert!(decode(FORMAT, &stray).is_err());
+        assert!(decode(2, &stray).is_err());
     }
 }

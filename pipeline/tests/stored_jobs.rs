@@ -73,6 +73,7 @@ fn a_mesh_folder_job_of_0_1_0_is_kept_under_its_id_and_follows_the_folder() {
             parameters: planned.parameters.clone(),
             experiment_porosity: None,
             experiment_std: None,
+            fluid: None,
         };
         store.add_jobs("scans", &[job]).await.unwrap();
     });

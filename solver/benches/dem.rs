@@ -3,32 +3,13 @@
 //! LAMMPS comparison bed of 2,450 spheres, and 2,000 ellipsoids, Rhine-scan polyhedra and
 //! bonded-sphere grains. Beds are built once and cached in target/sedpack-bench/.
 
-use std::path::PathBuf;
+mod beds;
 
+use beds::bed;
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use solver::bed::{BedSpec, build};
-use solver::dem::{Shaking, Simulation};
+use solver::bed::BedSpec;
+use solver::dem::Shaking;
 use solver::packing::ShapeKind;
-
-fn cache(spec: &BedSpec) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!(
-        "../target/sedpack-bench/{}-v{}.json",
-        spec.name(),
-        solver::VERSION
-    ))
-}
-
-fn bed(spec: &BedSpec) -> Simulation {
-    let path = cache(spec);
-    if let Some(sim) = std::fs::read_to_string(&path).ok().and_then(|s| serde_json::from_str(&s).ok()) {
-        return sim;
-    }
-    eprintln!("building {} for the benchmark, cached in {}", spec.name(), path.display());
-    let sim = build(spec, &mut |_| {}).expect("the standard beds build");
-    std::fs::create_dir_all(path.parent().expect("a folder")).expect("the cache folder");
-    std::fs::write(&path, serde_json::to_string(&sim).expect("serialisable")).expect("the cache file");
-    sim
-}
 
 fn particle_steps(c: &mut Criterion) {
     let mut group = c.benchmark_group("settled_bed");

@@ -4,6 +4,8 @@
 
 pub mod bed;
 pub mod dem;
+pub mod fabric;
+pub mod fluid;
 pub mod grain;
 pub mod packing;
 pub mod porosity;

@@ -62,6 +62,30 @@ fn segment_volume(z: f64, r: f64, a: f64, b: f64) -> f64 {
     std::f64::consts::PI * (r * r * (hi - lo) - (hi.powi(3) - lo.powi(3)) / 3.0)
 }
 
+/// Solid fraction of each slice k, [k h, (k + 1) h], of spheres given as (centre height,
+/// radius) in a domain of horizontal cross-section `area`, up to one slice more than the
+/// spheres reach (so that the top slice is empty); slice 0 also takes what lies below the floor.
+pub fn solid_fractions(spheres: &[(f64, f64)], area: f64, h: f64) -> Vec<f64> {
+    let top = spheres.iter().map(|(z, r)| z + r).fold(f64::NEG_INFINITY, f64::max);
+    let count = (top / h).ceil().max(0.0) as usize + 1;
+    let mut solid = vec![0.0; count];
+    for &(z, r) in spheres {
+        let first = ((z - r) / h).floor().max(0.0) as usize;
+        let last = (((z + r) / h).floor().max(0.0) as usize).min(count - 1);
+        for (k, volume) in solid.iter_mut().enumerate().take(last + 1).skip(first) {
+            let a = if k == 0 { f64::NEG_INFINITY } else { k as f64 * h };
+            *volume += segment_volume(z, r, a, (k + 1) as f64 * h);
+        }
+    }
+    solid.iter().map(|v| v / (area * h)).collect()
+}
+
+/// The free-surface index K of §4.4: scanning from the top down, the first k ≥ 1 with
+/// φ_k ≤ `threshold` ≤ φ_{k−1}; None when the fraction never crosses it.
+pub fn surface_index(fraction: &[f64], threshold: f64) -> Option<usize> {
+    (1..fraction.len()).rev().find(|&k| fraction[k] <= threshold && threshold <= fraction[k - 1])
+}
+
 /// Evaluates the porosity of volume-equivalent spheres given as (centre height, radius) in a
 /// domain of horizontal cross-section `area` (m²). Horizontal positions do not matter: in a
 /// periodic domain every grain counts whole wherever it lies.
@@ -74,24 +98,9 @@ pub fn evaluate(spheres: &[(f64, f64)], area: f64, settings: &PorositySettings) 
     if top / h > MAX_SLICES {
         return Err(PorosityError::TooManySlices { slice: h, height: top });
     }
-    // One more slice than the grains reach, so that the top slice is empty.
-    let count = (top / h).ceil().max(0.0) as usize + 1;
-    let mut solid = vec![0.0; count];
-    for &(z, r) in spheres {
-        let first = ((z - r) / h).floor().max(0.0) as usize;
-        let last = (((z + r) / h).floor().max(0.0) as usize).min(count - 1);
-        for (k, volume) in solid.iter_mut().enumerate().take(last + 1).skip(first) {
-            // Slice 0 also takes whatever lies below the floor.
-            let a = if k == 0 { f64::NEG_INFINITY } else { k as f64 * h };
-            *volume += segment_volume(z, r, a, (k + 1) as f64 * h);
-        }
-    }
-    let fraction: Vec<f64> = solid.iter().map(|v| v / (area * h)).collect();
+    let fraction = solid_fractions(spheres, area, h);
     let threshold = 1.0 - settings.cutoff;
-    let surface_index = (1..count)
-        .rev()
-        .find(|&k| fraction[k] <= threshold && threshold <= fraction[k - 1])
-        .ok_or(PorosityError::NoSurface(threshold))?;
+    let surface_index = surface_index(&fraction, threshold).ok_or(PorosityError::NoSurface(threshold))?;
     let surface = surface_index as f64 * h;
 
     // Whole slices inside [T, K h − T]; the tolerance absorbs round-off in k·h.

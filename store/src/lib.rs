@@ -126,6 +126,7 @@ impl Store {
                 .bind(job.experiment_porosity)
                 .bind(job.experiment_std)
                 .bind(now)
+                .bind(job.fluid.as_ref().map(|f| self.encode_json(f, &format!("fluid of job {}", job.id))).transpose()?)
                 .execute(&mut *tx)
                 .await
                 .map_err(self.db())?
@@ -297,6 +298,11 @@ impl Store {
         let profile = self.encode_json(&result.profile, &format!("profile of job {job_id}"))?;
         let particles = self.to_sql_int(result.particles, &format!("particles of job {job_id}"))?;
         let steps = self.to_sql_int(result.steps, &format!("steps of job {job_id}"))?;
+        let imbrication = result
+            .imbrication
+            .as_ref()
+            .map(|i| self.encode_json(i, &format!("imbrication of job {job_id}")))
+            .transpose()?;
         let now = now();
         let mut tx = self.pool.begin_with(sql::BEGIN_IMMEDIATE).await.map_err(self.db())?;
         let finished = sqlx::query(sql::FINISH_JOB)
@@ -323,6 +329,7 @@ impl Store {
             .bind(result.wall_time)
             .bind(&result.solver_version)
             .bind(now)
+            .bind(imbrication)
             .execute(&mut *tx)
             .await
             .map_err(self.db())?;
@@ -469,8 +476,8 @@ impl Store {
     /// Every job of the campaign in submission order, with its result and grain statistics,
     /// from one snapshot.
     pub async fn export(&self, campaign: &str) -> Result<Vec<ExportRow>, StoreError> {
-        type JobRow = (String, String, u64, u32, Option<String>, String, Option<f64>, Option<f64>);
-        type ResultRow = (String, f64, f64, f64, String, u64, f64, u64, f64, String);
+        type JobRow = (String, String, u64, u32, Option<String>, String, Option<f64>, Option<f64>, Option<String>);
+        type ResultRow = (String, f64, f64, f64, String, u64, f64, u64, f64, String, Option<String>);
         let mut tx = self.pool.begin().await.map_err(self.db())?;
         let campaign_id = self.campaign_id(&mut tx, campaign).await?;
         let jobs: Vec<JobRow> =
@@ -485,10 +492,23 @@ impl Store {
         tx.commit().await.map_err(self.db())?;
 
         let mut results_by_job = HashMap::new();
-        for (job_id, porosity, z_minus, z_plus, profile, particles, simulated_time, steps, wall_time, solver_version) in
-            results
+        for (
+            job_id,
+            porosity,
+            z_minus,
+            z_plus,
+            profile,
+            particles,
+            simulated_time,
+            steps,
+            wall_time,
+            solver_version,
+            imbrication,
+        ) in results
         {
             let profile = self.decode_json(&profile, &format!("profile of job {job_id}"))?;
+            let imbrication =
+                imbrication.map(|i| self.decode_json(&i, &format!("imbrication of job {job_id}"))).transpose()?;
             let result = JobResult {
                 porosity,
                 z_minus,
@@ -499,6 +519,7 @@ impl Store {
                 steps,
                 wall_time,
                 solver_version,
+                imbrication,
             };
             results_by_job.insert(job_id, result);
         }
@@ -507,7 +528,7 @@ impl Store {
             statistics_by_job.entry(job_id).or_default().push(GrainStatistic { name, mean, std });
         }
         jobs.into_iter()
-            .map(|(job_id, state, seed, attempts, error, parameters, experiment_porosity, experiment_std)| {
+            .map(|(job_id, state, seed, attempts, error, parameters, experiment_porosity, experiment_std, fluid)| {
                 Ok(ExportRow {
                     state: self.state(&job_id, &state)?,
                     seed,
@@ -516,6 +537,7 @@ impl Store {
                     parameters: self.decode_json(&parameters, &format!("parameters of job {job_id}"))?,
                     experiment_porosity,
                     experiment_std,
+                    fluid: fluid.map(|f| self.decode_json(&f, &format!("fluid of job {job_id}"))).transpose()?,
                     result: results_by_job.remove(&job_id),
                     grain_statistics: statistics_by_job.remove(&job_id).unwrap_or_default(),
                     job_id,

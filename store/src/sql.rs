@@ -21,8 +21,8 @@ pub const SET_EXECUTOR: &str = "UPDATE campaigns SET executor = ?2 WHERE name = 
 // Jobs
 pub const INSERT_JOB: &str = "
     INSERT INTO jobs (id, campaign_id, format, spec, seed, parameters, experiment_porosity, experiment_std,
-                      created_at)
-    VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)
+                      created_at, fluid)
+    VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10)
     ON CONFLICT (id) DO NOTHING";
 pub const JOB_CAMPAIGN: &str = "
     SELECT campaigns.name FROM jobs JOIN campaigns ON campaigns.id = jobs.campaign_id
@@ -83,8 +83,8 @@ pub const RUNNING_JOBS: &str = "
 // Results
 pub const INSERT_RESULT: &str = "
     INSERT INTO results (job_id, porosity, z_minus, z_plus, profile, particles, simulated_time,
-                         steps, wall_time, solver_version, created_at)
-    VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11)";
+                         steps, wall_time, solver_version, created_at, imbrication)
+    VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12)";
 pub const INSERT_GRAIN_STATISTIC: &str =
     "INSERT INTO grain_statistics (job_id, name, mean, std) VALUES (?1, ?2, ?3, ?4)";
 
@@ -110,11 +110,11 @@ pub const FAILURES: &str = "
     SELECT id, attempts, error FROM jobs
     WHERE campaign_id = ?1 AND state = 'failed' ORDER BY rowid";
 pub const EXPORT_JOBS: &str = "
-    SELECT id, state, seed, attempts, error, parameters, experiment_porosity, experiment_std FROM jobs
+    SELECT id, state, seed, attempts, error, parameters, experiment_porosity, experiment_std, fluid FROM jobs
     WHERE campaign_id = ?1 ORDER BY rowid";
 pub const EXPORT_RESULTS: &str = "
     SELECT results.job_id, porosity, z_minus, z_plus, profile, particles, simulated_time, steps,
-           results.wall_time, solver_version
+           results.wall_time, solver_version, imbrication
     FROM results JOIN jobs ON jobs.id = results.job_id
     WHERE jobs.campaign_id = ?1";
 pub const EXPORT_GRAIN_STATISTICS: &str = "

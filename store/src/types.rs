@@ -56,6 +56,8 @@ pub struct NewJob {
     /// The measured porosity the job is compared with, if any, and its standard deviation, if given.
     pub experiment_porosity: Option<f64>,
     pub experiment_std: Option<f64>,
+    /// The job's fluid forces as the caller describes them; None: buoyancy only.
+    pub fluid: Option<Value>,
 }
 
 /// A job handed to a worker by [`crate::Store::claim`].
@@ -98,6 +100,8 @@ pub struct JobResult {
     /// s of wall-clock time spent stepping, measured by the solver and summed over resumed attempts.
     pub wall_time: f64,
     pub solver_version: String,
+    /// The grains' imbrication as the caller wrote it, for packings that report one.
+    pub imbrication: Option<Value>,
 }
 
 /// Number-based mean and std of one form factor ("FL") or its inverse ("inv_FL") over a job's grains.
@@ -161,6 +165,7 @@ pub struct ExportRow {
     pub parameters: Map<String, Value>,
     pub experiment_porosity: Option<f64>,
     pub experiment_std: Option<f64>,
+    pub fluid: Option<Value>,
     pub result: Option<JobResult>,
     pub grain_statistics: Vec<GrainStatistic>,
 }

@@ -5,7 +5,8 @@ mod common;
 use std::time::Duration;
 
 use common::*;
-use store::{JobState, Store, StoreError};
+use serde_json::json;
+use store::{JobResult, JobState, Store, StoreError};
 
 #[tokio::test]
 async fn campaigns_are_upserted_by_name() {
@@ -228,7 +229,8 @@ async fn export_gives_every_job_with_its_result_and_statistics() {
     store.add_jobs("other", &[job(50)]).await.unwrap();
     let first = store.claim(CAMPAIGN, "w1").await.unwrap().unwrap();
     let second = store.claim(CAMPAIGN, "w1").await.unwrap().unwrap();
-    store.complete(&first.id, "w1", &result(0.371), &statistics(0.647)).await.unwrap();
+    let imbricated = JobResult { imbrication: Some(json!({"mean_dip": 21.5, "upstream": 0.6})), ..result(0.371) };
+    store.complete(&first.id, "w1", &imbricated, &statistics(0.647)).await.unwrap();
     store.fail(&second.id, "w1", "solver diverged").await.unwrap();
 
     let rows = store.export(CAMPAIGN).await.unwrap();
@@ -240,9 +242,11 @@ async fn export_gives_every_job_with_its_result_and_statistics() {
             (row.experiment_porosity, row.experiment_std),
             (submitted.experiment_porosity, submitted.experiment_std)
         );
+        assert_eq!(row.fluid, submitted.fluid);
     }
+    assert!(rows[0].fluid.is_some() && rows[1].fluid.is_none());
     assert_eq!(rows[0].state, JobState::Done);
-    assert_eq!(rows[0].result, Some(result(0.371)));
+    assert_eq!(rows[0].result, Some(imbricated));
     assert_eq!(rows[0].grain_statistics, statistics(0.647));
     assert_eq!(
         (rows[1].state, rows[1].error.as_deref(), &rows[1].result),

@@ -59,6 +59,7 @@ pub fn write_report(
     packings_section(&mut blocks, records)?;
     experiment_section(&mut blocks, records);
     shape_section(&mut blocks, records)?;
+    fluid_section(&mut blocks, records);
     match (dataset, selection) {
         (Some(d), Some(Ok(s))) => {
             dataset_section(&mut blocks, d);
@@ -461,6 +462,110 @@ fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), R
     Ok(())
 }
 
+/// Packings deposited with fluid forces: porosity per fluid beside the same setup without, and
+/// the long axes' imbrication where jobs report it.
+fn fluid_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
+    if records.iter().all(|r| r.fluid.is_none()) {
+        return;
+    }
+    blocks.push(Block::Heading("Fluid forces".into()));
+    blocks.push(Block::Paragraph(
+        "Packings deposited with the fluid forces of Sun & Xiao (§2.3: drag per component sphere after Syamlal et al., Eqs. 3–7, with the local fluid fraction; Saffman lift, Eq. 8) in a prescribed flow, beside those deposited with buoyancy only (the first paper's protocol). Runs that differ only in seed are grouped; the setup lists the other varied parameters.".into(),
+    ));
+    let fluid_key = |k: &str| k == "seed" || k == "process.fluid" || k.starts_with("fluid.");
+    let mut groups: Vec<(String, String, Vec<f64>)> = Vec::new();
+    for r in records {
+        let setup: Vec<String> = r
+            .parameters
+            .iter()
+            .filter(|(k, _)| !fluid_key(k))
+            .map(|(k, v)| format!("{k} = {}", value_text(v)))
+            .collect();
+        let setup = if setup.is_empty() { "all jobs".to_string() } else { setup.join(", ") };
+        let fluid = r.fluid.clone().unwrap_or_else(|| "buoyancy only".into());
+        match groups.iter_mut().find(|g| g.0 == setup && g.1 == fluid) {
+            Some(g) => g.2.push(r.porosity),
+            None => groups.push((setup, fluid, vec![r.porosity])),
+        }
+    }
+    groups.sort_by(|a, b| a.0.cmp(&b.0));
+    let rows = groups
+        .into_iter()
+        .map(|(setup, fluid, runs)| {
+            let mean = runs.iter().sum::<f64>() / runs.len() as f64;
+            let std = (runs.iter().map(|n| (n - mean).powi(2)).sum::<f64>() / runs.len() as f64).sqrt();
+            vec![setup, fluid, runs.len().to_string(), format!("{mean:.4}"), format!("{std:.4}")]
+        })
+        .collect();
+    blocks.push(Block::Table {
+        header: ["setup", "fluid", "runs", "porosity n (mean)", "std"].map(String::from).to_vec(),
+        rows,
+    });
+
+    let imbricated: Vec<(&JobRecord, String)> =
+        records.iter().zip(short_ids(records)).filter(|(r, _)| r.imbrication.is_some()).collect();
+    if imbricated.is_empty() {
+        return;
+    }
+    blocks.push(Block::Subheading("Imbrication".into()));
+    blocks.push(Block::Paragraph(
+        "The grains' long axes against the flow (+x): the dip is the angle between the long axis and the horizontal; its direction is the azimuth, from the flow direction, of the end that points down, so 180° means the axis dips upstream, leaning against the current as imbricated gravel does. The resultant is the mean of the dip directions weighted by the sine of the dip: its length runs from 0 (no preferred direction) to 1 (all alike).".into(),
+    ));
+    let percent = |x: f64| format!("{:.0}", 100.0 * x);
+    blocks.push(Block::Table {
+        header: [
+            "job",
+            "fluid",
+            "grains",
+            "mean dip (°)",
+            "dipping upstream (%)",
+            "resultant direction (°)",
+            "resultant length",
+        ]
+        .map(String::from)
+        .to_vec(),
+        rows: imbricated
+            .iter()
+            .map(|(r, id)| {
+                let f = r.imbrication.as_ref().expect("filtered");
+                vec![
+                    format!("`{id}`"),
+                    r.fluid.clone().unwrap_or_default(),
+                    f.grains.to_string(),
+                    format!("{:.1}", f.mean_dip),
+                    percent(f.upstream),
+                    format!("{:.0}", f.resultant_direction),
+                    format!("{:.2}", f.resultant_length),
+                ]
+            })
+            .collect(),
+    });
+    let histogram = |title: &str, labels: Vec<String>, shares: fn(&JobRecord) -> &[f64]| {
+        let mut header = vec![title.to_string()];
+        header.extend(labels);
+        let rows = imbricated
+            .iter()
+            .map(|(r, id)| {
+                let mut row = vec![format!("`{id}`")];
+                row.extend(shares(r).iter().map(|&x| percent(x)));
+                row
+            })
+            .collect();
+        Block::Table { header, rows }
+    };
+    blocks.push(Block::Paragraph("Share of the grains (%) per class of dip, then per direction of dip.".into()));
+    blocks.push(histogram(
+        "dip (°)",
+        (0..solver::fabric::DIP_BINS).map(|k| format!("{}–{}", 10 * k, 10 * k + 10)).collect(),
+        |r| &r.imbrication.as_ref().expect("filtered").dip,
+    ));
+    blocks.push(histogram(
+        "direction (°)",
+        (0..solver::fabric::DIRECTION_BINS).map(|k| format!("{}", 30 * k)).collect(),
+        |r| &r.imbrication.as_ref().expect("filtered").direction,
+    ));
+}
+
 fn dataset_section(blocks: &mut Vec<Block>, d: &Dataset) {
     blocks.push(Block::Heading("Dataset".into()));
     blocks.push(Block::Paragraph(format!(
@@ -795,6 +900,8 @@ mod tests {
             parameters: BTreeMap::new(),
             grain_statistics: BTreeMap::new(),
             experiment: None,
+            fluid: None,
+            imbrication: None,
         };
         let records = [record("0123456789abcdef"), record("0123456789abXdef"), record("short")];
         assert_eq!(short_ids(&records), ["0123456789abc", "0123456789abX", "short"]);

@@ -8,3 +8,4 @@ pub mod porosity;
 pub mod predict;
 pub mod report;
 pub mod sample;
+pub mod settle;

@@ -9,6 +9,7 @@ use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use serde_json::{Map, Value, json};
+use solver::fabric::Imbrication;
 use solver::packing::{Packing, PackingResult, Phase};
 
 use crate::cli::PackArgs;
@@ -33,6 +34,9 @@ struct ResultFile<'a> {
     experiment: Option<analysis::Experiment>,
     statistics: Map<String, Value>,
     profile: &'a [solver::porosity::ProfilePoint],
+    /// With fluid forces on: the long axes' fabric against the flow.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    imbrication: Option<&'a Imbrication>,
 }
 
 pub fn run(args: &PackArgs) -> anyhow::Result<()> {
@@ -67,8 +71,21 @@ pub fn run(args: &PackArgs) -> anyhow::Result<()> {
         )
         .row("particles", record.particles.to_string())
         .row("simulated time", format!("{:.3} s in {} steps", record.simulated_time, record.steps))
-        .row("wall time", format!("{:.1} s", record.wall_time))
-        .row("output", out.display().to_string());
+        .row("wall time", format!("{:.1} s", record.wall_time));
+    if let Some(f) = record.imbrication {
+        table.row(
+            "imbrication",
+            format!(
+                "{} grains: mean dip {:.1}°, {:.0} % dipping upstream, resultant {:.0}° (length {:.2})",
+                f.grains,
+                f.mean_dip,
+                100.0 * f.upstream,
+                f.resultant_direction,
+                f.resultant_length
+            ),
+        );
+    }
+    table.row("output", out.display().to_string());
     table.print()?;
     Ok(())
 }
@@ -122,6 +139,7 @@ fn result_file<'a>(job: &'a JobSpec, result: &'a PackingResult) -> ResultFile<'a
         experiment: job.experiment,
         statistics,
         profile: &result.porosity.profile,
+        imbrication: result.imbrication.as_ref(),
     }
 }
 

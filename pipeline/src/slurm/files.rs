@@ -310,6 +310,7 @@ mod tests {
                 steps: 50_000,
                 wall_time: 0.5,
                 solver_version: "0.1.0".into(),
+                imbrication: Some(serde_json::json!({"grains": 40, "upstream": 0.6})),
             },
             grain_statistics: vec![GrainStatistic { name: "FL".into(), mean: 1.0, std: 0.0 }],
         }

@@ -21,6 +21,7 @@ use super::material::Material;
 use super::neighbours::{BuildScratch, NeighbourList};
 use super::shape::{Pose, Shape};
 use crate::SolverError;
+use crate::fluid::{self, Fluid};
 
 /// Time steps per collision below which the linear spring-dashpot is not resolved (the paper
 /// uses T_c/Δt = 40, §4.2).
@@ -134,6 +135,7 @@ pub struct Memory {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct StageTimes {
     pub neighbours: Duration,
+    pub fluid: Duration,
     pub contacts: Duration,
     pub bodies: Duration,
 }
@@ -158,6 +160,11 @@ pub struct Simulation {
     /// Of those, the contacts between pieces of two bodies.
     #[serde(default)]
     pub pair_contacts: usize,
+    /// Fluid drag and lift (off: buoyancy only, the first paper's protocol). Set by whoever
+    /// drives the simulation, as the packing does every step from its spec; not kept in the
+    /// state, so that states and cached beds keep their format.
+    #[serde(skip)]
+    pub fluid: Option<Fluid>,
     #[serde(skip)]
     pipeline: Pipeline,
 }
@@ -171,6 +178,8 @@ struct Pipeline {
     poses: Vec<Pose>,
     /// The neighbour list's cell grid and previous list.
     build: BuildScratch,
+    /// The fluid fraction grid and this step's fluid force and torque per body.
+    fluid: fluid::Scratch,
     stage_times: StageTimes,
 }
 
@@ -195,6 +204,7 @@ impl Simulation {
             damping: None,
             contacts: 0,
             pair_contacts: 0,
+            fluid: None,
             pipeline: Pipeline::default(),
         })
     }
@@ -227,6 +237,11 @@ impl Simulation {
         }
         self.pose_bodies();
         let after_neighbours = Instant::now();
+        if let Some(fluid) = &self.fluid {
+            let density = self.settings.material.fluid_density;
+            fluid.apply(&self.bodies, &self.domain, density, &mut self.pipeline.fluid);
+        }
+        let after_fluid = Instant::now();
         let (pair_contacts, worst_overlap) = self.pair_contacts();
         let after_contacts = Instant::now();
         if worst_overlap > MAX_RELATIVE_OVERLAP {
@@ -243,7 +258,8 @@ impl Simulation {
         self.steps += 1;
         let times = &mut self.pipeline.stage_times;
         times.neighbours += after_neighbours - start;
-        times.contacts += after_contacts - after_neighbours;
+        times.fluid += after_fluid - after_neighbours;
+        times.contacts += after_contacts - after_fluid;
         times.bodies += end - after_contacts;
         Ok(())
     }
@@ -372,6 +388,7 @@ impl Simulation {
         let weight_per_volume = settings.material.weight_per_volume();
         let shaking = self.shaking.map_or(0.0, |s| s.acceleration(self.time));
         let damping = self.damping.map(|c| c.powf(dt));
+        let fluid = self.fluid.is_some().then_some(&self.pipeline.fluid.loads[..]);
         let b = &mut self.bodies;
         (
             b.position.par_iter_mut(),
@@ -389,6 +406,10 @@ impl Simulation {
                 let mass = b.mass[k];
                 let mut force = weight_per_volume * b.volume[k] + Vector3::new(mass * shaking, 0.0, 0.0);
                 let mut torque = Vector3::zeros();
+                if let Some(loads) = fluid {
+                    force += loads[k].force;
+                    torque += loads[k].torque;
+                }
                 let (as_i, as_j) = neighbours.pairs_of(k);
                 for &pair in as_i {
                     let pf = &pair_forces[pair as usize];

@@ -5,7 +5,9 @@
 
 mod spec;
 
-pub use spec::{Derived, DomainKind, FormSpec, GrainSpec, PackingSpec, Process, ShapeKind, SpecError, in_range};
+pub use spec::{
+    Derived, DomainKind, FluidSpec, FormSpec, GrainSpec, PackingSpec, Process, ShapeKind, SpecError, in_range,
+};
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -19,6 +21,8 @@ use thiserror::Error;
 use crate::SolverError;
 use crate::dem::shape::{ConvexPolyhedron, Polyhedron};
 use crate::dem::{NewBody, Settings, Shape, Simulation, uniform_rotation};
+use crate::fabric::{Imbrication, imbrication};
+use crate::fluid::Fluid;
 use crate::grain::{
     FormParameters, FormSampler, FormStatistic, MeshLibrary, SizeSampler, bonded_grain, form_statistics,
 };
@@ -97,6 +101,9 @@ pub struct PackingResult {
     /// Mean and (population) standard deviation of every Table 1 factor X and of X⁻¹ over the
     /// grains, where defined for every grain.
     pub statistics: Vec<FormStatistic>,
+    /// The long axes' fabric against the flow (+x), for packings deposited with fluid forces on
+    /// and grains that have a long axis.
+    pub imbrication: Option<Imbrication>,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -118,6 +125,8 @@ pub struct Packing {
     /// The convex base shape of each mesh of the library, shared by the grains drawn from it.
     #[serde(skip)]
     bases: Vec<Arc<ConvexPolyhedron>>,
+    /// The spec's fluid forces, handed to the simulation every step (it does not keep them).
+    fluid: Option<Fluid>,
 }
 
 /// Steps between checks of whether the last set has left the generation region.
@@ -155,6 +164,7 @@ impl Packing {
             last_height: None,
             wall_time: Duration::ZERO,
             bases: Vec::new(),
+            fluid: spec.fluid_forces(),
             spec,
             derived,
         })
@@ -234,6 +244,7 @@ impl Packing {
             }
             self.simulation.shaking = (self.phase != Phase::Damping).then_some(p.shaking);
             self.simulation.damping = (self.phase == Phase::Damping).then_some(p.damping);
+            self.simulation.fluid = self.fluid;
             self.simulation.step()?;
         }
         Ok(self.phase)
@@ -341,6 +352,7 @@ impl Packing {
             steps: self.simulation.steps,
             wall_time: self.wall_time,
             statistics: form_statistics(&self.grains.iter().map(|g| g.form).collect::<Vec<_>>()),
+            imbrication: self.fluid.and_then(|_| imbrication(&b.shape, &b.orientation)),
         })
     }
 }

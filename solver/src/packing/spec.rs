@@ -8,6 +8,8 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::dem::{Calibration, Domain, MIN_STEPS_PER_COLLISION, Material, Shaking};
+use crate::fluid::flow::Flow;
+use crate::fluid::{Fluid, WATER};
 use crate::grain::{FormDistribution, MeshLibrary, RHINE_FORMS, SieveCurve, TABLE3};
 
 /// The two domains of §4.1.
@@ -50,6 +52,24 @@ pub struct GrainSpec {
     pub meshes: Option<MeshLibrary>,
 }
 
+/// Fluid drag and lift during the whole protocol (the second paper's §2.3), in a prescribed
+/// flow; the fluid's density is the material's `fluid_density`, which buoyancy uses too.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FluidSpec {
+    /// Dynamic viscosity μ (Pa·s).
+    pub viscosity: f64,
+    pub flow: Flow,
+    /// Saffman lift (Eq. 8).
+    pub lift: bool,
+    /// Cell side of the fluid-fraction grid (m); None: three times the largest sieve in use.
+    pub cell: Option<f64>,
+}
+
+impl FluidSpec {
+    /// Still water at 20 °C (viscosity), with lift, cells of three grain sizes.
+    pub const STILL_WATER: Self = Self { viscosity: WATER.viscosity, flow: Flow::Quiescent, lift: true, cell: None };
+}
+
 /// Process parameters of §4.3 (generation, shaking, damping, convergence).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Process {
@@ -89,6 +109,9 @@ pub struct PackingSpec {
     pub cutoff: f64,
     pub trim: Option<f64>,
     pub seed: u64,
+    /// Fluid forces; None in the paper's protocol, whose grains settle "as if submerged", with
+    /// buoyancy alone (§4.2).
+    pub fluid: Option<FluidSpec>,
 }
 
 /// The values of a packing that the paper derives from the others, as the protocol uses them.
@@ -104,6 +127,8 @@ pub struct Derived {
     pub trim: f64,
     /// Verlet skin of the neighbour list (m).
     pub skin: f64,
+    /// Cell side of the fluid-fraction grid (m).
+    pub fluid_cell: f64,
 }
 
 /// A value no packing can run with: the job file's dotted key and what was expected.
@@ -164,6 +189,7 @@ impl PackingSpec {
             cutoff: 0.5,
             trim: None,
             seed: 1,
+            fluid: None,
         }
     }
 
@@ -183,7 +209,22 @@ impl PackingSpec {
         });
         // A skin of 15 % of the smallest grain keeps neighbour lists for ~100 steps at 1 m/s.
         let skin = 0.15 * size.smallest_in_use();
-        Derived { spacing, height, max_time, trim, skin }
+        // CFD–DEM averages over cells of a few grains (Sun & Xiao's sediment-transport runs: 1.2
+        // nominal diameters across, their settling runs one).
+        let fluid_cell = self.fluid.and_then(|f| f.cell).unwrap_or(3.0 * size.largest_in_use());
+        Derived { spacing, height, max_time, trim, skin, fluid_cell }
+    }
+
+    /// The fluid forces of the engine for this spec, if on.
+    pub fn fluid_forces(&self) -> Option<Fluid> {
+        self.fluid.map(|f| Fluid {
+            viscosity: f.viscosity,
+            flow: f.flow,
+            lift: f.lift,
+            cell: self.derived().fluid_cell,
+            slice: self.slice,
+            cutoff: self.cutoff,
+        })
     }
 
     /// Checks every value, in the order of the job file's sections.
@@ -209,6 +250,37 @@ impl PackingSpec {
         in_range("evaluation.cutoff", self.cutoff, self.cutoff > 0.0 && self.cutoff < 1.0, "a porosity in (0, 1)")?;
         if let Some(t) = self.trim {
             in_range("evaluation.trim", t, t >= 0.0, "a height ≥ 0")?;
+        }
+        if let Some(fluid) = &self.fluid {
+            self.check_fluid(fluid)?;
+        }
+        Ok(())
+    }
+
+    fn check_fluid(&self, fluid: &FluidSpec) -> Result<(), SpecError> {
+        positive("fluid.viscosity", fluid.viscosity)?;
+        if let Some(h) = fluid.cell {
+            let largest = self.grains.size.largest_in_use();
+            in_range(
+                "fluid.cell",
+                h,
+                h >= largest,
+                &format!("at least the largest sieve in use, {largest} m (cells average over several grains)"),
+            )?;
+        }
+        match fluid.flow {
+            Flow::Quiescent => {}
+            Flow::Uniform { velocity } => {
+                in_range("fluid.flow.velocity", velocity.norm(), true, "finite components (m/s)")?;
+            }
+            Flow::Laminar { shear_velocity, depth } => {
+                in_range("fluid.flow.shear_velocity", shear_velocity, shear_velocity >= 0.0, "a speed ≥ 0")?;
+                positive("fluid.flow.depth", depth)?;
+            }
+            Flow::Logarithmic { shear_velocity, roughness } => {
+                in_range("fluid.flow.shear_velocity", shear_velocity, shear_velocity >= 0.0, "a speed ≥ 0")?;
+                positive("fluid.flow.roughness", roughness)?;
+            }
         }
         Ok(())
     }

@@ -15,7 +15,7 @@ pub fn db_path(dir: &tempfile::TempDir) -> PathBuf {
 }
 
 /// Job `index` of a grid over mu_fl, as the pipeline would describe it; every other job is
-/// compared with a measurement, every fourth with its spread.
+/// compared with a measurement, every fourth with its spread, every third has fluid forces.
 pub fn job(index: usize) -> NewJob {
     let mu_fl = 0.4 + 0.01 * index as f64;
     let seed = index as u64 % 3 + 1;
@@ -30,6 +30,7 @@ pub fn job(index: usize) -> NewJob {
         parameters,
         experiment_porosity: index.is_multiple_of(2).then_some(0.371),
         experiment_std: index.is_multiple_of(4).then_some(0.001),
+        fluid: index.is_multiple_of(3).then(|| json!({"flow": "logarithmic", "shear_velocity": 0.05})),
     }
 }
 
@@ -48,6 +49,7 @@ pub fn result(porosity: f64) -> JobResult {
         steps: 1_500_000,
         wall_time: 42.0,
         solver_version: "sedpack 0.1.0".into(),
+        imbrication: None,
     }
 }
 
