@@ -315,14 +315,9 @@ fn experiment_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
     let rows = groups
         .iter()
         .map(|(label, runs, experiment)| {
-            let mean = runs.iter().sum::<f64>() / runs.len() as f64;
             // Population std of the runs, as Table 6 reports it (its U1 row: 0.382, 0.381, 0.386 → ± 0.002).
-            let spread = if runs.len() > 1 {
-                let var = runs.iter().map(|n| (n - mean).powi(2)).sum::<f64>() / runs.len() as f64;
-                format!("{mean:.3} ± {:.3}", var.sqrt())
-            } else {
-                format!("{mean:.3}")
-            };
+            let (mean, std) = mean_std(runs);
+            let spread = if runs.len() > 1 { format!("{mean:.3} ± {std:.3}") } else { format!("{mean:.3}") };
             let measured = experiment.porosity;
             differences.push((mean - measured).abs());
             vec![
@@ -492,8 +487,7 @@ fn fluid_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
     let rows = groups
         .into_iter()
         .map(|(setup, fluid, runs)| {
-            let mean = runs.iter().sum::<f64>() / runs.len() as f64;
-            let std = (runs.iter().map(|n| (n - mean).powi(2)).sum::<f64>() / runs.len() as f64).sqrt();
+            let (mean, std) = mean_std(&runs);
             vec![setup, fluid, runs.len().to_string(), format!("{mean:.4}"), format!("{std:.4}")]
         })
         .collect();

@@ -188,25 +188,15 @@ pub fn run(args: &SettleArgs) -> anyhow::Result<()> {
     }
     table
         .row("sphericity φ, CSF, Powers P", format!("{:.3}, {:.3}, {}", phi, corey, roundness))
-        .row(
-            "Haider & Levenspiel (1989)",
-            format!(
-                "{} m/s, C_D {}",
-                number(report.haider_levenspiel.terminal_velocity),
-                number(report.haider_levenspiel.drag_coefficient)
-            ),
-        )
-        .row(
-            "Dietrich (1982)",
-            format!(
-                "{} m/s, C_D {}",
-                number(report.dietrich.terminal_velocity),
-                number(report.dietrich.drag_coefficient)
-            ),
-        );
+        .row("Haider & Levenspiel (1989)", correlation_text(&report.haider_levenspiel))
+        .row("Dietrich (1982)", correlation_text(&report.dietrich));
     for note in &report.notes {
         table.row("note", note.clone());
     }
     table.print()?;
     Ok(())
+}
+
+fn correlation_text(c: &Correlation) -> String {
+    format!("{} m/s, C_D {}", number(c.terminal_velocity), number(c.drag_coefficient))
 }
