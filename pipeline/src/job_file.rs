@@ -132,6 +132,7 @@ pub struct FluidFile {
     pub flow: Option<FlowFile>,
     pub lift: Option<bool>,
     pub cell: Option<Auto>,
+    pub coupling: Option<Auto>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -224,7 +225,10 @@ pub struct Source<'a> {
 impl Source<'_> {
     /// "FILE:LINE: key: message" (line omitted when the key is not written in the file).
     pub fn error(&self, key: &str, message: impl fmt::Display) -> anyhow::Error {
-        match locate(self.text, key) {
+        // A key left out is shown at the line of the nearest parent written, where it belongs.
+        let written = |k: &str| locate(self.text, k);
+        let line = written(key).or_else(|| key.rmatch_indices('.').find_map(|(at, _)| written(&key[..at])));
+        match line {
             Some(line) => anyhow!("{}:{line}: {key}: {message}", self.path.display()),
             None => anyhow!("{}: {key}: {message}", self.path.display()),
         }

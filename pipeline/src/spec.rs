@@ -199,6 +199,7 @@ fn fluid(f: FluidFile, drag: bool, density_given: bool, spec: &mut PackingSpec, 
             ("fluid.flow", f.flow.is_some()),
             ("fluid.lift", f.lift.is_some()),
             ("fluid.cell", f.cell.is_some()),
+            ("fluid.coupling", f.coupling.is_some()),
         ];
         return match given.iter().find(|(_, given)| *given) {
             Some((key, _)) => Err(source.error(key, "applies with process.fluid: drag only")),
@@ -209,6 +210,7 @@ fn fluid(f: FluidFile, drag: bool, density_given: bool, spec: &mut PackingSpec, 
     set(&mut fluid.viscosity, f.viscosity);
     set(&mut fluid.lift, f.lift);
     fluid.cell = f.cell.and_then(|c| c.given());
+    fluid.coupling = f.coupling.and_then(|c| c.given());
     if let Some(flow) = f.flow {
         fluid.flow = flow_of(flow, source)?;
     }

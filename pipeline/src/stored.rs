@@ -77,6 +77,10 @@ mod v1 {
         pub(super) flow: Flow,
         pub(super) lift: bool,
         pub(super) cell: f64,
+        /// Absent in jobs stored before it was a key, which updated their fluid forces every
+        /// time step.
+        #[serde(default)]
+        pub(super) coupling: Option<f64>,
     }
 
     #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -333,6 +337,7 @@ fn from_v1(job: v1::Job) -> anyhow::Result<JobSpec> {
             },
             lift: f.lift,
             cell: Some(f.cell),
+            coupling: Some(f.coupling.unwrap_or(time_step)),
         }),
     };
     packing.check().context("the stored job")?;
@@ -421,6 +426,7 @@ fn identity(job: &JobSpec) -> v1::Job {
                 },
                 lift: f.lift,
                 cell: derived.fluid_cell,
+                coupling: Some(derived.fluid_coupling),
             }),
         },
         experiment: job.experiment.map(|e| v1::Experiment { porosity: e.porosity, std: e.std }),
@@ -430,7 +436,7 @@ fn identity(job: &JobSpec) -> v1::Job {
 #[cfg(test)]
 mod tests {
     use solver::grain::MeshLibrary;
-    use solver::packing::DomainKind;
+    use solver::packing::{DomainKind, FLUID_COUPLING};
 
     use super::*;
 
@@ -497,7 +503,7 @@ mod tests {
     }
 
     #[test]
-    fn a_job_with_fluid_forces_is_format_3_and_reads_back_with_its_cell_concrete() {
+    fn a_job_with_fluid_forces_is_format_3_and_reads_back_with_its_cell_and_coupling_concrete() {
         let mut spec = PackingSpec::paper(DomainKind::Periodic);
         spec.fluid = Some(FluidSpec {
             flow: Flow::Logarithmic { shear_velocity: 0.05, roughness: 2e-4 },
@@ -510,6 +516,13 @@ mod tests {
         let back = decode(3, &stored).unwrap();
         assert_eq!(back.packing.fluid.map(|f| f.flow), original.packing.fluid.map(|f| f.flow));
         assert_eq!(canonical_json(&back), canonical_json(&original));
+        assert_eq!(stored["job"]["packing"]["fluid"]["coupling"], serde_json::json!(FLUID_COUPLING));
+        // Stored before the coupling was a key, a job updated its fluid forces every step.
+        let mut before = stored.clone();
+        before["job"]["packing"]["fluid"].as_object_mut().unwrap().remove("coupling");
+        let every_step = decode(3, &before).unwrap().packing;
+        assert_eq!(every_step.fluid.and_then(|f| f.coupling), Some(every_step.time_step));
+        assert_eq!(every_step.fluid_forces().map(|f| f.coupling), Some(1));
         for older in [1, 2] {
             let json = if older == 1 { stored["job"].clone() } else { stored.clone() };
             let error = decode(older, &json).unwrap_err().to_string();

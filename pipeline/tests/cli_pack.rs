@@ -87,6 +87,17 @@ fn bad_job_files_name_the_file_line_and_key() {
     fails(&["pack", &spacing], &["spacing.yaml:2", "process.generation.spacing", "smallest sieve"]);
     let std = write(dir.path(), "std.yaml", "experiment: {porosity: 0.35, std: -0.01}\n");
     fails(&["pack", &std], &["std.yaml:1", "experiment.std"]);
+    // Fluid keys: only with drag on; a coupling shorter than the time step; a flow's keys.
+    let dry = write(dir.path(), "dry.yaml", "fluid:\n  coupling: 1.0e-4\n");
+    fails(&["pack", &dry], &["dry.yaml:2", "fluid.coupling", "process.fluid: drag"]);
+    let coupling = write(dir.path(), "coupling.yaml", "process: {fluid: drag}\nfluid:\n  coupling: 1.0e-7\n");
+    fails(&["pack", &coupling], &["coupling.yaml", "fluid.coupling", "solver.time_step"]);
+    let flow = write(
+        dir.path(),
+        "flow.yaml",
+        "process: {fluid: drag}\nfluid:\n  flow: {kind: logarithmic, roughness: 1.0e-4}\n",
+    );
+    fails(&["pack", &flow], &["flow.yaml:3", "fluid.flow.shear_velocity", "required"]);
     fails(&["pack", "/no/such/job.yaml"], &["/no/such/job.yaml"]);
     fails(&["run", "/no/such/campaign.yaml", "--checkpoint-interval=-1"], &["--checkpoint-interval"]);
 }

@@ -39,3 +39,33 @@ fn campaign_files_give_the_job_ids_of_version_0_1_0() {
     let frozen = sedpack::campaign::read_campaign(&fixture("job-ids/validation-cylinder.yaml")).unwrap();
     assert_eq!(ids(&reordered.jobs), ids(&frozen.jobs));
 }
+
+#[test]
+fn every_ready_campaign_file_reads_and_the_drag_study_pairs_its_seeds() {
+    let dir = std::path::PathBuf::from(repo("campaigns"));
+    let mut files = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "yaml") {
+            let campaign = sedpack::campaign::read_campaign(&path).unwrap_or_else(|e| panic!("{e:#}"));
+            assert!(!campaign.jobs.is_empty(), "{}", path.display());
+            files += 1;
+        }
+    }
+    assert!(files >= 10, "{files} campaign files");
+    // With and without drag, the same eight seeds, otherwise the same jobs.
+    let drag = sedpack::campaign::read_campaign(repo("campaigns/drag.yaml").as_ref()).unwrap();
+    let seeds = |wet: bool| {
+        let mut seeds: Vec<u64> =
+            drag.jobs.iter().filter(|j| j.spec.packing.fluid.is_some() == wet).map(|j| j.spec.packing.seed).collect();
+        seeds.sort();
+        seeds
+    };
+    assert_eq!(seeds(true), (1..=8).collect::<Vec<u64>>());
+    assert_eq!(seeds(false), seeds(true));
+    let first = &drag.jobs[0].spec.packing;
+    for job in &drag.jobs {
+        let p = &job.spec.packing;
+        assert_eq!((&p.grains, &p.domain, &p.process), (&first.grains, &first.domain, &first.process));
+    }
+}

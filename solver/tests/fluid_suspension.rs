@@ -6,9 +6,9 @@ use nalgebra::{UnitQuaternion, Vector3};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use solver::dem::{Calibration, Domain, Material, NewBody, Settings, Shape, Simulation};
-use solver::fluid::flow::Flow;
 use solver::fluid::settling::{richardson_zaki_exponent, sphere_terminal_velocity};
 use solver::fluid::{Fluid, WATER};
+use solver::packing::FLUID_COUPLING;
 
 /// Mean vertical velocity of the spheres in the middle of a cloud at solid fraction `phi`,
 /// after 8 relaxation times, over u_t ε^n; and the terminal Reynolds number of one sphere.
@@ -51,14 +51,8 @@ fn hindered(d: f64, phi: f64, spheres: usize, time_step: f64) -> (f64, f64) {
             angular_velocity: Vector3::zeros(),
         });
     }
-    sim.fluid = Some(Fluid {
-        viscosity: WATER.viscosity,
-        flow: Flow::Quiescent,
-        lift: true,
-        cell: 3.0 * d,
-        slice: d,
-        cutoff: 0.5,
-    });
+    // Updated every 1e-4 s, as in a packing.
+    sim.fluid = Some(Fluid::still(WATER.viscosity, 3.0 * d, (FLUID_COUPLING / time_step).round() as u32));
     let steps = (8.0 * tau / time_step).ceil() as usize;
     for _ in 0..steps {
         sim.step().unwrap();

@@ -21,7 +21,7 @@ use super::material::Material;
 use super::neighbours::{BuildScratch, NeighbourList};
 use super::shape::{Pose, Shape};
 use crate::SolverError;
-use crate::fluid::{self, Fluid};
+use crate::fluid::{self, Fluid, FluidResponse};
 
 /// Time steps per collision below which the linear spring-dashpot is not resolved (the paper
 /// uses T_c/Δt = 40, §4.2).
@@ -165,6 +165,11 @@ pub struct Simulation {
     /// state, so that states and cached beds keep their format.
     #[serde(skip)]
     pub fluid: Option<Fluid>,
+    /// Each body's fluid force and torque as of the last update of the fluid forces, kept in
+    /// the state so that a restored simulation goes on exactly as it would have; empty with
+    /// fluid forces off.
+    #[serde(default)]
+    fluid_response: Vec<FluidResponse>,
     #[serde(skip)]
     pipeline: Pipeline,
 }
@@ -178,7 +183,7 @@ struct Pipeline {
     poses: Vec<Pose>,
     /// The neighbour list's cell grid and previous list.
     build: BuildScratch,
-    /// The fluid fraction grid and this step's fluid force and torque per body.
+    /// The fluid fraction grid and what the fluid stage keeps of each body's shape.
     fluid: fluid::Scratch,
     stage_times: StageTimes,
 }
@@ -205,6 +210,7 @@ impl Simulation {
             contacts: 0,
             pair_contacts: 0,
             fluid: None,
+            fluid_response: Vec::new(),
             pipeline: Pipeline::default(),
         })
     }
@@ -237,9 +243,17 @@ impl Simulation {
         }
         self.pose_bodies();
         let after_neighbours = Instant::now();
-        if let Some(fluid) = &self.fluid {
-            let density = self.settings.material.fluid_density;
-            fluid.apply(&self.bodies, &self.domain, density, &mut self.pipeline.fluid);
+        match &self.fluid {
+            // Due every `coupling` steps, and whenever bodies came or fluid forces were just on.
+            Some(fluid)
+                if self.steps.is_multiple_of(u64::from(fluid.coupling.max(1)))
+                    || self.fluid_response.len() != self.bodies.len() =>
+            {
+                let density = self.settings.material.fluid_density;
+                fluid.update(&self.bodies, &self.domain, density, &mut self.pipeline.fluid, &mut self.fluid_response);
+            }
+            Some(_) => {}
+            None => self.fluid_response.clear(),
         }
         let after_fluid = Instant::now();
         let (pair_contacts, worst_overlap) = self.pair_contacts();
@@ -388,7 +402,7 @@ impl Simulation {
         let weight_per_volume = settings.material.weight_per_volume();
         let shaking = self.shaking.map_or(0.0, |s| s.acceleration(self.time));
         let damping = self.damping.map(|c| c.powf(dt));
-        let fluid = self.fluid.is_some().then_some(&self.pipeline.fluid.loads[..]);
+        let fluid = self.fluid.is_some().then_some(&self.fluid_response[..]);
         let b = &mut self.bodies;
         (
             b.position.par_iter_mut(),
@@ -406,9 +420,10 @@ impl Simulation {
                 let mass = b.mass[k];
                 let mut force = weight_per_volume * b.volume[k] + Vector3::new(mass * shaking, 0.0, 0.0);
                 let mut torque = Vector3::zeros();
-                if let Some(loads) = fluid {
-                    force += loads[k].force;
-                    torque += loads[k].torque;
+                if let Some(responses) = fluid {
+                    let (f, t) = responses[k].load(v, w);
+                    force += f;
+                    torque += t;
                 }
                 let (as_i, as_j) = neighbours.pairs_of(k);
                 for &pair in as_i {

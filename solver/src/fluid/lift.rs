@@ -30,13 +30,17 @@ impl SaffmanLift {
         slip: &Vector3<f64>,
         vorticity: &Vector3<f64>,
     ) -> Vector3<f64> {
+        slip.cross(vorticity) * self.coefficient(fluid, diameter, vorticity)
+    }
+
+    /// K of f = K (w × ω), linear in the slip w: C_l ρ_f ν^½ d²/|ω|^½, zero without vorticity.
+    #[inline]
+    pub fn coefficient(&self, fluid: &FluidProperties, diameter: f64, vorticity: &Vector3<f64>) -> f64 {
         let strength = vorticity.norm();
         if strength == 0.0 {
-            return Vector3::zeros();
+            return 0.0;
         }
-        slip.cross(vorticity)
-            * (self.coefficient * fluid.density * fluid.kinematic_viscosity().sqrt() * diameter * diameter
-                / strength.sqrt())
+        self.coefficient * fluid.density * fluid.kinematic_viscosity().sqrt() * diameter * diameter / strength.sqrt()
     }
 }
 

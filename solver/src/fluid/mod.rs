@@ -5,10 +5,10 @@
 //! Buoyancy stays where it was, in the engine's gravity minus buoyancy (Eq. 10 of the first
 //! paper), with the same fluid density.
 //!
-//! Per step, as a stage of [`crate::dem::Simulation::step`] when fluid forces are on: the
-//! grains' volumes are spread over a coarse grid for the fluid fraction ([`fraction`]), the bed
-//! surface is found where a channel profile needs it, then every body gets its fluid force and
-//! torque:
+//! Every `coupling` steps, as a stage of [`crate::dem::Simulation::step`] when fluid forces are
+//! on: the grains' volumes are spread over a coarse grid for the fluid fraction ([`fraction`]),
+//! the bed surface is found where a channel profile needs it, then every body gets its fluid
+//! force and torque as a [`FluidResponse`], linear in the body's velocity:
 //! - a sphere and each component sphere of a bonded grain: drag (Eqs. 3–7) and lift (Eq. 8) at
 //!   its centre, with the velocity of that point of the grain and the fluid fraction at the
 //!   grain's centre of mass; a bonded grain's spheres are sheltered by the wakes of the grain's
@@ -16,6 +16,14 @@
 //! - an ellipsoid or a polyhedron, which is not made of spheres: Haider & Levenspiel's (1989)
 //!   drag curve for its sphericity under the same hindrance, and lift as on the sphere of equal
 //!   volume, at its centre, so no torque: such a grain keeps the orientation it has.
+//!
+//! A CFD–DEM code such as the second paper's (SediFoam: OpenFOAM with LAMMPS) computes the fluid
+//! forces once per fluid time step and keeps them over the many DEM steps in between. sedpack
+//! keeps, instead of the forces, the drag and lift coefficients and the fluid velocities of the
+//! update (both linear in the slip), and every step applies them to the body's velocity of that
+//! step (as CFD–DEM codes with a semi-implicit drag do): a grain that starts, stops or bounces
+//! between two updates feels the drag of its new velocity at once, and the drag stays stable
+//! where its response time in a dense bed is a few steps.
 
 pub mod drag;
 pub mod flow;
@@ -25,7 +33,7 @@ pub mod settling;
 pub mod shielding;
 pub mod sphericity;
 
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -57,13 +65,55 @@ pub struct Fluid {
     /// which channel profiles are measured.
     pub slice: f64,
     pub cutoff: f64,
+    /// Time steps from one update of the fluid forces to the next (≥ 1): the fluid time step
+    /// of a CFD–DEM code over the DEM's Δt.
+    pub coupling: u32,
 }
 
-/// A body's fluid force and torque (about its centre of mass) of one step.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct FluidLoad {
-    pub force: Vector3<f64>,
-    pub torque: Vector3<f64>,
+/// A body's fluid force and torque (about its centre of mass) as of the last update, linear in
+/// its velocity v and angular velocity ω: f = f₀ − B v + C ω and t = t₀ − E v + G ω. The sum
+/// over its spheres j (arm r_j from the centre of mass, fluid velocity U_j) of the drag and
+/// lift T_j (U_j − v − ω × r_j), T_j = s_j (β_j I − K_j [ω_f]×): the slip, sheltered by s_j,
+/// times the drag coefficient β_j of the update's slip, and Saffman's K_j (w × ω_f). At the
+/// update it is the exact force and torque of that step.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct FluidResponse {
+    force: Vector3<f64>,
+    force_velocity: Matrix3<f64>,
+    force_spin: Matrix3<f64>,
+    torque: Vector3<f64>,
+    torque_velocity: Matrix3<f64>,
+    torque_spin: Matrix3<f64>,
+}
+
+impl FluidResponse {
+    /// Force and torque on the body at velocity `v` and angular velocity `w`.
+    #[inline]
+    pub fn load(&self, v: &Vector3<f64>, w: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+        (
+            self.force - self.force_velocity * v + self.force_spin * w,
+            self.torque - self.torque_velocity * v + self.torque_spin * w,
+        )
+    }
+
+    /// Adds a sphere at `arm` seeing fluid velocity `fluid` through the slip map `t`.
+    fn add(&mut self, t: &Matrix3<f64>, fluid: &Vector3<f64>, arm: &Vector3<f64>) {
+        // w = U − v − ω × r = U − v + [r]× ω.
+        let r = arm.cross_matrix();
+        let f = t * fluid;
+        self.force += f;
+        self.force_velocity += t;
+        self.force_spin += t * r;
+        self.torque += arm.cross(&f);
+        self.torque_velocity += r * t;
+        self.torque_spin += r * t * r;
+    }
+}
+
+/// The slip map of one sphere: drag β and lift K (w × ω), both scaled by the shelter s.
+fn slip_map(shelter: f64, drag: f64, lift: f64, vorticity: &Vector3<f64>) -> Matrix3<f64> {
+    // w × ω = −[ω]× w.
+    (Matrix3::identity() * drag - vorticity.cross_matrix() * lift) * shelter
 }
 
 /// A sphere of a body as the fluid sees it: the body itself as its sphere of equal volume, or
@@ -108,8 +158,8 @@ impl BodyShape {
     }
 }
 
-/// The fluid stage's working memory, owned by the step pipeline: filled afresh every step but
-/// for what depends on shapes alone.
+/// The fluid stage's working memory, owned by the step pipeline: filled afresh at every update
+/// but for what depends on shapes alone.
 #[derive(Debug, Clone, Default)]
 pub struct Scratch {
     grid: FractionGrid,
@@ -121,13 +171,24 @@ pub struct Scratch {
     spheres: Vec<(f64, f64)>,
     /// Height of the bed surface the profiles are measured from (m).
     pub bed: f64,
-    /// This step's fluid force and torque of each body.
-    pub loads: Vec<FluidLoad>,
 }
 
 impl Fluid {
-    /// The fluid forces on every body this step, into `scratch.loads`.
-    pub fn apply(&self, bodies: &Bodies, domain: &Domain, density: f64, scratch: &mut Scratch) {
+    /// Still water of `viscosity` with lift, averaged over cells of side `cell` and updated
+    /// every `coupling` steps (the bed surface's slice and cut-off serve channel flows only).
+    pub fn still(viscosity: f64, cell: f64, coupling: u32) -> Self {
+        Self { viscosity, flow: Flow::Quiescent, lift: true, cell, slice: cell, cutoff: 0.5, coupling }
+    }
+
+    /// The fluid force and torque of every body from this step on, into `responses`.
+    pub fn update(
+        &self,
+        bodies: &Bodies,
+        domain: &Domain,
+        density: f64,
+        scratch: &mut Scratch,
+        responses: &mut Vec<FluidResponse>,
+    ) {
         let fluid = FluidProperties { density, viscosity: self.viscosity };
         let n = bodies.len();
         for k in scratch.shapes.len()..n {
@@ -150,16 +211,16 @@ impl Fluid {
         scratch.first.push(scratch.wet.len());
         scratch.bed = if self.flow.needs_bed() { self.bed_surface(bodies, domain, &mut scratch.spheres) } else { 0.0 };
 
-        let Scratch { grid, shapes, bed, wet, first, loads, .. } = scratch;
-        loads.resize(n, FluidLoad::default());
-        loads.par_iter_mut().enumerate().for_each(|(k, load)| {
+        let Scratch { grid, shapes, bed, wet, first, .. } = scratch;
+        responses.resize(n, FluidResponse::default());
+        responses.par_iter_mut().enumerate().for_each(|(k, response)| {
             let wet = &wet[first[k]..first[k + 1]];
             // The fluid fraction the other grains leave, at the centre of mass: the grid
             // averages over cells of several grains, so one value serves all of a grain's spheres.
             let centre = grid.stencil(&bodies.position[k]);
             let own: f64 = wet.iter().map(|w| w.volume * w.stencil.overlap(&centre)).sum();
             let hindrance = Hindrance::new(grid.fluid_fraction(&centre, own));
-            *load = match shapes[k].curve {
+            *response = match shapes[k].curve {
                 Some(curve) => self.single_body(bodies, k, &shapes[k], curve, &hindrance, *bed, &fluid),
                 None => self.spheres(bodies, k, wet, &shapes[k], &hindrance, *bed, &fluid),
             };
@@ -177,15 +238,15 @@ impl Fluid {
         hindrance: &Hindrance,
         bed: f64,
         fluid: &FluidProperties,
-    ) -> FluidLoad {
+    ) -> FluidResponse {
         let (velocity, vorticity) = self.flow.at(&bodies.position[k], bed, fluid.kinematic_viscosity());
-        let slip = velocity - bodies.velocity[k];
+        let speed = (velocity - bodies.velocity[k]).norm();
         let d = shape.diameter;
-        let mut force = SyamlalOBrien { curve }.force(fluid, d, bodies.volume[k], hindrance, &slip);
-        if self.lift {
-            force += SaffmanLift::PAPER.force(fluid, d, &slip, &vorticity);
-        }
-        FluidLoad { force, torque: Vector3::zeros() }
+        let drag = SyamlalOBrien { curve }.coefficient(fluid, d, bodies.volume[k], hindrance, speed);
+        let lift = if self.lift { SaffmanLift::PAPER.coefficient(fluid, d, &vorticity) } else { 0.0 };
+        let mut response = FluidResponse::default();
+        response.add(&slip_map(1.0, drag, lift, &vorticity), &velocity, &Vector3::zeros());
+        response
     }
 
     /// Drag and lift on each sphere of a sphere or bonded grain, summed at the centre of mass.
@@ -199,39 +260,36 @@ impl Fluid {
         hindrance: &Hindrance,
         bed: f64,
         fluid: &FluidProperties,
-    ) -> FluidLoad {
+    ) -> FluidResponse {
         let x = bodies.position[k];
         let nu = fluid.kinematic_viscosity();
-        // Fluid velocity minus the grain's velocity at a sphere's centre, and the vorticity there.
+        // Fluid velocity and vorticity at a sphere's centre, and the slip there.
         let seen = |w: &Wet| {
             let (velocity, vorticity) = self.flow.at(&w.center, bed, nu);
-            (velocity - bodies.point_velocity(k, &(w.center - x)), vorticity)
+            (velocity, vorticity, velocity - bodies.point_velocity(k, &(w.center - x)))
         };
         let wake = (wet.len() > 1)
             .then(|| {
-                Wake::new(&(wet.iter().map(|w| seen(w).0 * w.volume).sum::<Vector3<f64>>() / bodies.volume[k]), nu)
+                Wake::new(&(wet.iter().map(|w| seen(w).2 * w.volume).sum::<Vector3<f64>>() / bodies.volume[k]), nu)
             })
             .flatten();
-        let mut load = FluidLoad::default();
+        let mut response = FluidResponse::default();
         for (j, w) in wet.iter().enumerate() {
-            let (mut slip, vorticity) = seen(w);
-            if let Some(wake) = &wake {
+            let (velocity, vorticity, slip) = seen(w);
+            let shelter = wake.as_ref().map_or(1.0, |wake| {
                 let touching = &shape.touching[shape.start[j] as usize..shape.start[j + 1] as usize];
-                slip *= wake.shelter(
+                wake.shelter(
                     &w.center,
                     w.radius,
                     touching.iter().map(|&i| (wet[i as usize].center, wet[i as usize].radius)),
-                );
-            }
+                )
+            });
             let d = 2.0 * w.radius;
-            let mut f = SyamlalOBrien::SPHERES.force(fluid, d, w.volume, hindrance, &slip);
-            if self.lift {
-                f += SaffmanLift::PAPER.force(fluid, d, &slip, &vorticity);
-            }
-            load.force += f;
-            load.torque += (w.center - x).cross(&f);
+            let drag = SyamlalOBrien::SPHERES.coefficient(fluid, d, w.volume, hindrance, shelter * slip.norm());
+            let lift = if self.lift { SaffmanLift::PAPER.coefficient(fluid, d, &vorticity) } else { 0.0 };
+            response.add(&slip_map(shelter, drag, lift, &vorticity), &velocity, &(w.center - x));
         }
-        load
+        response
     }
 
     /// The free surface of §4.4 (first paper) over the bodies as volume-equivalent spheres: the

@@ -6,7 +6,6 @@ use nalgebra::{UnitQuaternion, Vector3};
 
 use super::Fluid;
 use super::drag::{DallaValle, FluidProperties};
-use super::flow::Flow;
 use crate::SolverError;
 use crate::dem::{Calibration, Domain, MIN_STEPS_PER_COLLISION, Material, NewBody, Settings, Shape, Simulation};
 
@@ -163,7 +162,8 @@ pub fn drop(drop: &Drop) -> Result<Settling, SolverError> {
         velocity: Vector3::zeros(),
         angular_velocity: Vector3::zeros(),
     });
-    sim.fluid = Some(Fluid { viscosity, flow: Flow::Quiescent, lift: true, cell: width, slice: reach, cutoff: 0.5 });
+    // One grain is cheap: its fluid forces are updated every step.
+    sim.fluid = Some(Fluid::still(viscosity, width, 1));
 
     let (long, short) = principal_axes(&shape);
     let angles = |q: &UnitQuaternion<f64>| {

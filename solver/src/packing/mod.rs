@@ -6,7 +6,8 @@
 mod spec;
 
 pub use spec::{
-    Derived, DomainKind, FluidSpec, FormSpec, GrainSpec, PackingSpec, Process, ShapeKind, SpecError, in_range,
+    Derived, DomainKind, FLUID_COUPLING, FluidSpec, FormSpec, GrainSpec, PackingSpec, Process, ShapeKind, SpecError,
+    in_range,
 };
 
 use std::sync::Arc;
