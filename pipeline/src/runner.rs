@@ -275,14 +275,19 @@ impl Worker {
             pool.install(|| simulate(&id, spec, checkpoint.as_ref().map(|c| &c.data[..]), &mut relay, interval))
         });
         let mut heartbeat = tokio::time::interval(HEARTBEAT);
+        // The log says at each checkpoint where the packing stands, for runs without a terminal.
+        let mut last: Option<Progress> = None;
         loop {
             tokio::select! {
                 // Messages first, so that none sent before the packing ended is lost.
                 biased;
                 Some(message) = receiver.recv() => match message {
-                    Message::Progress(p) => self.bar.set_message(format!(
-                        "{label}: {} t = {:.3} s, {} grains, {} contacts", p.phase.name(), p.time, p.grains, p.contacts
-                    )),
+                    Message::Progress(p) => {
+                        self.bar.set_message(format!(
+                            "{label}: {} t = {:.3} s, {} grains, {} contacts", p.phase.name(), p.time, p.grains, p.contacts
+                        ));
+                        last = Some(p);
+                    }
                     Message::Warning(text) => {
                         warn!(job, "{text}");
                         self.bar.println(format!("sedpack: warning: job {job}: {text}"));
@@ -291,6 +296,17 @@ impl Worker {
                         if let Err(e) = self.store.save_checkpoint(job, &self.id, &data, time).await {
                             warn!(job, error = %e, "checkpoint not saved; stopping the job");
                             lost.store(true, Ordering::SeqCst);
+                        } else if let Some(p) = &last {
+                            info!(
+                                job,
+                                simulated_time = time,
+                                phase = p.phase.name(),
+                                grains = p.grains,
+                                mass_created = format!("{:.1} %", 100.0 * p.created),
+                                contacts = p.contacts,
+                                bytes = data.len(),
+                                "checkpoint"
+                            );
                         } else {
                             info!(job, simulated_time = time, bytes = data.len(), "checkpoint");
                         }

@@ -187,6 +187,11 @@ fn a_killed_runner_resumes_from_its_checkpoint_with_identical_results() {
     }
     let log = std::fs::read_to_string(dir.path().join("killed.log")).unwrap();
     assert!(log.contains("requeued the job of a dead worker") && log.contains("resuming from a checkpoint"), "{log}");
+    // Each checkpoint says where its packing stood, for runs watched through the log alone.
+    let checkpoint = log.lines().find(|l| l.contains(" checkpoint ")).expect("a checkpoint line");
+    for field in ["simulated_time=", "phase=", "grains=", "mass_created=", "contacts="] {
+        assert!(checkpoint.contains(field), "{field} in {checkpoint}");
+    }
 }
 
 #[test]
