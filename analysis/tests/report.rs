@@ -356,3 +356,42 @@ fn a_campaign_over_grain_shapes_compares_them_at_equal_form() {
     let svg = check_html(out.path(), 3);
     assert!(svg.contains("Porosity by grain shape"));
 }
+
+/// Packings with and without drag, paired by seed; numbers worked by hand.
+#[test]
+fn a_campaign_with_and_without_drag_compares_them_seed_by_seed() {
+    let runs = [
+        (None, [(1, 0.350), (2, 0.360), (3, 0.340)].as_slice()),
+        (Some("drag and lift, still water"), &[(1, 0.372), (2, 0.380), (3, 0.365), (4, 0.391)]),
+    ];
+    let mut records = Vec::new();
+    for (fluid, porosities) in runs {
+        for &(seed, n) in porosities {
+            records.push(JobRecord {
+                job_id: format!("{}-{seed}", fluid.is_some()),
+                porosity: n,
+                profile: vec![],
+                parameters: BTreeMap::from([
+                    ("process.fluid".into(), json!(if fluid.is_some() { "drag" } else { "none" })),
+                    ("seed".into(), json!(seed)),
+                ]),
+                grain_statistics: grain_statistics(&[(0.6, 0.7); 3]),
+                experiment: None,
+                fluid: fluid.map(String::from),
+                imbrication: None,
+            });
+        }
+    }
+    let out = tempfile::tempdir().unwrap();
+    let files = report("drag", &records, out.path());
+    let md = std::fs::read_to_string(&files.markdown).unwrap();
+    // Without drag: mean 0.350, population std √(2e-4/3) = 0.00816. With drag: mean 0.377,
+    // std √(3.74e-4/4) = 0.00967. Seeds 1–3 pair: differences 0.022, 0.020, 0.025, mean
+    // 0.02233, sample std 0.002517, standard error 0.002517/√3 = 0.00145; seed 4 has no pair.
+    assert!(md.contains("| all jobs | buoyancy only | 3 | 0.3500 | 0.0082 | — |"), "{md}");
+    assert!(
+        md.contains("| all jobs | drag and lift, still water | 4 | 0.3770 | 0.0097 | +0.0223 ± 0.0015 (3 pairs) |"),
+        "{md}"
+    );
+    check_html(out.path(), 0);
+}

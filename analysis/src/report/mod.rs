@@ -457,6 +457,34 @@ fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), R
     Ok(())
 }
 
+/// The fluid of a packing deposited without fluid forces.
+const DRY: &str = "buoyancy only";
+
+/// A run's seed (None where the campaign did not vary it) and porosity.
+type SeededRun = (Option<String>, f64);
+
+/// Mean ± standard error of the differences `wet − dry` over the seeds both have, and the
+/// number of pairs; "—" without any.
+fn paired_difference(wet: &[SeededRun], dry: &[SeededRun]) -> String {
+    let differences: Vec<f64> = wet
+        .iter()
+        .filter_map(|(seed, n)| {
+            let seed = seed.as_ref()?;
+            dry.iter().find(|(s, _)| s.as_ref() == Some(seed)).map(|(_, m)| n - m)
+        })
+        .collect();
+    let pairs = differences.len();
+    if pairs == 0 {
+        return "—".into();
+    }
+    let mean = differences.iter().sum::<f64>() / pairs as f64;
+    if pairs == 1 {
+        return format!("{mean:+.4} (1 pair)");
+    }
+    let variance = differences.iter().map(|d| (d - mean).powi(2)).sum::<f64>() / (pairs - 1) as f64;
+    format!("{mean:+.4} ± {:.4} ({pairs} pairs)", (variance / pairs as f64).sqrt())
+}
+
 /// Packings deposited with fluid forces: porosity per fluid beside the same setup without, and
 /// the long axes' imbrication where jobs report it.
 fn fluid_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
@@ -468,7 +496,7 @@ fn fluid_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
         "Packings deposited with the fluid forces of Sun & Xiao (§2.3: drag per component sphere after Syamlal et al., Eqs. 3–7, with the local fluid fraction; Saffman lift, Eq. 8) in a prescribed flow, beside those deposited with buoyancy only (the first paper's protocol). Runs that differ only in seed are grouped; the setup lists the other varied parameters.".into(),
     ));
     let fluid_key = |k: &str| k == "seed" || k == "process.fluid" || k.starts_with("fluid.");
-    let mut groups: Vec<(String, String, Vec<f64>)> = Vec::new();
+    let mut groups: Vec<(String, String, Vec<SeededRun>)> = Vec::new();
     for r in records {
         let setup: Vec<String> = r
             .parameters
@@ -477,24 +505,40 @@ fn fluid_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
             .map(|(k, v)| format!("{k} = {}", value_text(v)))
             .collect();
         let setup = if setup.is_empty() { "all jobs".to_string() } else { setup.join(", ") };
-        let fluid = r.fluid.clone().unwrap_or_else(|| "buoyancy only".into());
+        let fluid = r.fluid.clone().unwrap_or_else(|| DRY.into());
+        let run = (r.parameters.get("seed").map(value_text), r.porosity);
         match groups.iter_mut().find(|g| g.0 == setup && g.1 == fluid) {
-            Some(g) => g.2.push(r.porosity),
-            None => groups.push((setup, fluid, vec![r.porosity])),
+            Some(g) => g.2.push(run),
+            None => groups.push((setup, fluid, vec![run])),
         }
     }
     groups.sort_by(|a, b| a.0.cmp(&b.0));
     let rows = groups
-        .into_iter()
+        .iter()
         .map(|(setup, fluid, runs)| {
-            let (mean, std) = mean_std(&runs);
-            vec![setup, fluid, runs.len().to_string(), format!("{mean:.4}"), format!("{std:.4}")]
+            let porosities: Vec<f64> = runs.iter().map(|r| r.1).collect();
+            let (mean, std) = mean_std(&porosities);
+            let dry = groups.iter().find(|g| g.0 == *setup && g.1 == DRY).filter(|_| fluid != DRY);
+            let paired = dry.map_or("—".to_string(), |dry| paired_difference(runs, &dry.2));
+            vec![
+                setup.clone(),
+                fluid.clone(),
+                runs.len().to_string(),
+                format!("{mean:.4}"),
+                format!("{std:.4}"),
+                paired,
+            ]
         })
         .collect();
     blocks.push(Block::Table {
-        header: ["setup", "fluid", "runs", "porosity n (mean)", "std"].map(String::from).to_vec(),
+        header: ["setup", "fluid", "runs", "porosity n (mean)", "std", "minus buoyancy only, same seeds"]
+            .map(String::from)
+            .to_vec(),
         rows,
     });
+    blocks.push(Block::Paragraph(
+        "The last column pairs each run with the run of the same seed deposited with buoyancy only: the mean of their differences ± its standard error (the sample standard deviation of the differences over √pairs), and the number of pairs. Pairing takes out what the seed alone decides, so a small effect shows sooner than in the two means.".into(),
+    ));
 
     let imbricated: Vec<(&JobRecord, String)> =
         records.iter().zip(short_ids(records)).filter(|(r, _)| r.imbrication.is_some()).collect();
