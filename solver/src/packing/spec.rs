@@ -229,14 +229,16 @@ impl PackingSpec {
 
     /// The fluid forces of the engine for this spec, if on.
     pub fn fluid_forces(&self) -> Option<Fluid> {
-        self.fluid.map(|f| Fluid {
-            viscosity: f.viscosity,
-            flow: f.flow,
-            lift: f.lift,
-            cell: self.derived().fluid_cell,
+        let fluid = self.fluid?;
+        let derived = self.derived();
+        Some(Fluid {
+            viscosity: fluid.viscosity,
+            flow: fluid.flow,
+            lift: fluid.lift,
+            cell: derived.fluid_cell,
             slice: self.slice,
             cutoff: self.cutoff,
-            coupling: (self.derived().fluid_coupling / self.time_step).round().max(1.0) as u32,
+            coupling: (derived.fluid_coupling / self.time_step).round().max(1.0) as u32,
         })
     }
 
