@@ -206,8 +206,8 @@ fn pyramid(body: &PolyhedronPose, apex: u32, center: &V3, face: &[V3; 3], other_
         *c = cut(w)?;
     }
     let cuts = &cuts[..ring.len()];
-    let spin = (face[1] - face[0]).cross(&(face[2] - face[0]));
-    let inside = |x: &V3| (0..3).all(|k| (face[(k + 1) % 3] - face[k]).cross(&(x - face[k])).dot(&spin) >= 0.0);
+    let inward = edge_normals(face);
+    let inside = |x: &V3| (0..3).all(|k| inward[k].dot(&(x - face[k])) >= 0.0);
     // The apex lies in the other body when it lies in the tetrahedron of the face and that
     // body's centre.
     let side = |x: &V3, u: &V3, v: &V3| (u - other_center).cross(&(v - other_center)).dot(&(x - other_center));
@@ -232,6 +232,14 @@ fn pyramid(body: &PolyhedronPose, apex: u32, center: &V3, face: &[V3; 3], other_
     }
     let base = moment / (3.0 * area);
     Some(Tip::Closed(p + (base - p) * 0.75))
+}
+
+/// For each edge k (from corner k to k + 1) of a counter-clockwise triangle, a normal in its
+/// plane pointing into it: x lies in the triangle when every one has x − corner k along it.
+/// ((c_{k+1} − c_k) × (x − c_k)) · s = (s × (c_{k+1} − c_k)) · (x − c_k), s the triangle's spin.
+fn edge_normals(corners: &[V3; 3]) -> [V3; 3] {
+    let spin = (corners[1] - corners[0]).cross(&(corners[2] - corners[0]));
+    [0, 1, 2].map(|k| spin.cross(&(corners[(k + 1) % 3] - corners[k])))
 }
 
 /// The overlap of edge `ea` of A (centred at the origin) with edge `eb` of B (centred at `d`):
@@ -330,7 +338,9 @@ fn for_each_face_beyond(
     mut clip: impl FnMut(V3, f64) -> Option<()>,
 ) -> Option<()> {
     let shape = body.shape();
-    let beyond = |v: u32| side * (axis.dot(&(center + body.vertex(v))) - level) > 0.0;
+    // Heights along the axis in the body's own frame: one product per vertex met.
+    let (local, base) = (body.local(&(axis * side)), side * (level - axis.dot(center)));
+    let beyond = |v: u32| local.dot(&shape.vertices()[v as usize]) > base;
     triangles_beyond(body, &(axis * side), beyond, |t| {
         let normal = body.normal(t);
         clip(normal, normal.dot(&(center + body.vertex(shape.triangles()[t as usize][0]))))
@@ -353,37 +363,73 @@ fn triangles_beyond(
     if !beyond(top) {
         return Some(());
     }
-    let mut seen = [0u32; CAP_VERTICES];
-    let mut n_seen = 1;
-    seen[0] = top;
-    let mut taken = [0u32; CAP_TRIANGLES];
-    let mut n_taken = 0;
-    let mut next = 0;
-    while next < n_seen {
-        let v = seen[next];
-        next += 1;
-        for &t in shape.incident_to(v) {
-            if taken[..n_taken].contains(&t) {
-                continue;
-            }
-            if n_taken == CAP_TRIANGLES {
-                return None;
-            }
-            taken[n_taken] = t;
-            n_taken += 1;
-            visit(t)?;
-        }
-        for &w in shape.neighbours_of(v) {
-            if !seen[..n_seen].contains(&w) && beyond(w) {
-                if n_seen == CAP_VERTICES {
+    MARKS.with_borrow_mut(|marks| {
+        let mark = marks.next(shape.vertices().len(), shape.triangles().len());
+        let mut seen = [0u32; CAP_VERTICES];
+        let mut n_seen = 1;
+        seen[0] = top;
+        marks.vertex[top as usize] = mark;
+        let mut n_taken = 0;
+        let mut next = 0;
+        while next < n_seen {
+            let v = seen[next];
+            next += 1;
+            for &t in shape.incident_to(v) {
+                if marks.triangle[t as usize] == mark {
+                    continue;
+                }
+                if n_taken == CAP_TRIANGLES {
                     return None;
                 }
-                seen[n_seen] = w;
-                n_seen += 1;
+                marks.triangle[t as usize] = mark;
+                n_taken += 1;
+                visit(t)?;
+            }
+            for &w in shape.neighbours_of(v) {
+                if marks.vertex[w as usize] != mark && beyond(w) {
+                    if n_seen == CAP_VERTICES {
+                        return None;
+                    }
+                    marks.vertex[w as usize] = mark;
+                    seen[n_seen] = w;
+                    n_seen += 1;
+                }
             }
         }
+        Some(())
+    })
+}
+
+/// Which vertices and triangles a walk has met: each walk marks them with a new number, so
+/// that nothing is cleared between walks.
+#[derive(Debug, Default)]
+struct Marks {
+    vertex: Vec<u32>,
+    triangle: Vec<u32>,
+    current: u32,
+}
+
+impl Marks {
+    /// The mark of a new walk on a shape of this many vertices and triangles.
+    fn next(&mut self, vertices: usize, triangles: usize) -> u32 {
+        if self.vertex.len() < vertices {
+            self.vertex.resize(vertices, 0);
+        }
+        if self.triangle.len() < triangles {
+            self.triangle.resize(triangles, 0);
+        }
+        if self.current == u32::MAX {
+            self.vertex.fill(0);
+            self.triangle.fill(0);
+            self.current = 0;
+        }
+        self.current += 1;
+        self.current
     }
-    Some(())
+}
+
+thread_local! {
+    static MARKS: RefCell<Marks> = RefCell::new(Marks::default());
 }
 
 /// Vertices, faces and corners per face a cell can hold.
@@ -500,7 +546,8 @@ impl Cell {
     fn bound(&mut self) {
         let used = &self.vertices[..self.n_vertices];
         self.center = used.iter().sum::<V3>() / used.len().max(1) as f64;
-        self.radius = used.iter().map(|v| (v - self.center).norm()).fold(0.0, f64::max);
+        // One root for the largest distance (the root is monotonic, so the same value).
+        self.radius = used.iter().map(|v| (v - self.center).norm_squared()).fold(0.0, f64::max).sqrt();
     }
 
     /// Keeps the part of the cell where normal · x ≤ offset (`normal` of unit length, x relative
@@ -782,10 +829,11 @@ impl Slab {
         slab.len = 0;
         slab.lo = V2::repeat(f64::INFINITY);
         slab.hi = V2::repeat(f64::NEG_INFINITY);
+        let height = |v: u32| axes[2].dot(&shape.vertices()[v as usize]) + shift.z;
         triangles_beyond(
             pose,
             &(frame.n * side),
-            |v| side * (at(v).z - level) > 0.0,
+            |v| side * (height(v) - level) > 0.0,
             |t| {
                 let p = shape.triangles()[t as usize].map(at);
                 let normal = frame.coordinates(&pose.normal(t));
@@ -815,14 +863,21 @@ impl Slab {
             if lo.x > other.hi.x || lo.y > other.hi.y || hi.x < other.lo.x || hi.y < other.lo.y {
                 continue;
             }
-            if !first && other.facets[..other.len].iter().any(|g| flush(facet, g)) {
-                continue;
-            }
             polygon.reset(&facet.p);
-            for plane in other.facets[..other.len].iter().filter(|g| !flush(facet, g)) {
+            let mut lies_flush = false;
+            for plane in &other.facets[..other.len] {
+                if flush(facet, plane) {
+                    lies_flush = true;
+                    continue;
+                }
                 polygon.clip(|x| plane.offset - plane.normal.dot(x))?;
+                if polygon.len == 0 {
+                    break;
+                }
             }
-            integrals.add(&polygon, &facet.normal);
+            if polygon.len > 0 && (first || !lies_flush) {
+                integrals.add(&polygon, &facet.normal);
+            }
         }
         Some(())
     }
@@ -965,6 +1020,22 @@ mod tests {
             cell.face(&normal, &f.map(|k| v[k])).unwrap();
         }
         cell.bound();
+    }
+
+    #[test]
+    fn a_walk_never_sees_the_marks_of_an_earlier_one_even_when_the_counter_wraps() {
+        let mut marks = Marks::default();
+        let first = marks.next(4, 3);
+        marks.vertex[2] = first;
+        marks.triangle[1] = first;
+        // A larger shape next: its new entries must not carry the current mark either.
+        let second = marks.next(6, 5);
+        assert_ne!(second, first);
+        assert!(marks.vertex.iter().chain(&marks.triangle).all(|&m| m != second));
+        marks.vertex[5] = second;
+        marks.current = u32::MAX;
+        let third = marks.next(6, 5);
+        assert!(marks.vertex.iter().chain(&marks.triangle).all(|&m| m != third), "{marks:?}");
     }
 
     #[test]

@@ -162,19 +162,20 @@ pub fn with_walls(p: &Piece, domain: &Domain, mut point: impl FnMut(u32, u64, &C
 
 #[inline(never)]
 fn polyhedron_walls(pose: &PolyhedronPose, domain: &Domain, point: &mut impl FnMut(u32, u64, &ContactGeometry, f64)) {
-    let floor = polyhedron::polyhedron_plane_manifold(pose, &Vector3::zeros(), &Vector3::z());
-    let wall = match *domain {
-        Domain::Cylinder { diameter } => {
-            let c = diameter / 2.0;
-            polyhedron::polyhedron_cylinder_wall_manifold(pose, c, c, c)
+    // Each manifold is used where it is made: they are a few hundred bytes, and most grains
+    // touch no wall.
+    let mut points_of = |w: u32, m: &Manifold| {
+        for j in 0..m.len {
+            point(w, m.features[j], &m.point(j), m.weights[j]);
         }
-        Domain::Periodic { .. } => None,
     };
-    for (w, m) in [(0, floor), (1, wall)] {
-        if let Some(m) = m {
-            for j in 0..m.len {
-                point(w, m.features[j], &m.point(j), m.weights[j]);
-            }
+    if let Some(m) = polyhedron::polyhedron_plane_manifold(pose, &Vector3::zeros(), &Vector3::z()) {
+        points_of(0, &m);
+    }
+    if let Domain::Cylinder { diameter } = *domain {
+        let c = diameter / 2.0;
+        if let Some(m) = polyhedron::polyhedron_cylinder_wall_manifold(pose, c, c, c) {
+            points_of(1, &m);
         }
     }
 }

@@ -222,7 +222,7 @@ fn solve_polyhedra(
         };
     }
     stats.converged = end.is_some_and(|e| e.converged);
-    let Some(end) = end.filter(|e| e.depth > 0.0) else {
+    let Some(end) = end.as_ref().filter(|e| e.depth > 0.0) else {
         stats.support_queries = cso.queries;
         return (None, Apart::default(), stats, None);
     };
@@ -231,9 +231,9 @@ fn solve_polyhedra(
         (p.vertex_a, p.vertex_b)
     });
     stats.support_queries = cso.queries;
-    let (point, overlap) = centre_of_pressure::contact_point(a, b, &end, mode == Mode::Coherent);
+    let (point, overlap) = centre_of_pressure::contact_point(a, b, end, mode == Mode::Coherent);
     stats.overlap = Some(overlap);
-    let kept = features_of(&end, apex);
+    let kept = features_of(end, apex);
     (
         Some(ContactGeometry { point: a.center() + point, normal: end.normal, depth: end.depth }),
         Apart::default(),
