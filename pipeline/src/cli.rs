@@ -196,6 +196,11 @@ pub struct ContinueArgs {
     /// Return failed jobs to pending and try them again.
     #[arg(long)]
     pub retry_failed: bool,
+    /// Start over the pending jobs whose checkpoints another version of sedpack wrote (without
+    /// it, such jobs stop `run` and `resume` before anything starts, so that an upgrade never
+    /// throws packing work away unasked).
+    #[arg(long)]
+    pub discard_old_checkpoints: bool,
     /// Wall-clock seconds between checkpoints of a running packing.
     #[arg(long, default_value_t = 300.0)]
     pub checkpoint_interval: f64,

@@ -2,8 +2,9 @@
 //! blocking task with its own rayon pool, sending heartbeats and checkpoints while it runs. A
 //! Ctrl-C returns running jobs to pending, and so does a worker that fails (a store error): it
 //! stops the others, which return their jobs too. Jobs of a killed runner are found by their
-//! dead process or their stale heartbeat and run again, from their last checkpoint when this
-//! version can use it (and saying why when it cannot).
+//! dead process or their stale heartbeat and run again from their last checkpoint. A checkpoint
+//! another version of sedpack wrote holds work this version cannot continue: such a job stops
+//! the run, job and checkpoint untouched, unless the user asks to start it over.
 
 use std::path::Path;
 use std::sync::Arc;
@@ -13,7 +14,7 @@ use std::time::{Duration, Instant};
 use anyhow::anyhow;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use solver::packing::{Packing, PackingResult, Phase, Progress};
-use store::{ClaimedJob, Store};
+use store::{ClaimedJob, JobState, Store};
 use tokio::sync::mpsc;
 use tracing::{info, warn};
 
@@ -39,6 +40,66 @@ pub struct RunOptions {
     pub workers: usize,
     /// Wall time between checkpoints of a running packing.
     pub checkpoint_interval: Duration,
+    /// Start over the jobs whose checkpoints another version of sedpack wrote; without it such
+    /// a job stops the run before its packing starts, job and checkpoint left as they were.
+    pub discard_old_checkpoints: bool,
+}
+
+/// A pending job's checkpoint that this version cannot continue.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OldCheckpoint {
+    pub job: String,
+    /// The format number it starts with.
+    pub format: u32,
+    /// Where the packing was, when the store knows.
+    pub simulated_time: Option<f64>,
+}
+
+/// The format of a checkpoint another version of sedpack wrote; `None` for this version's and
+/// for bytes that do not start with a format number (unreadable: nothing in them to keep).
+pub fn old_format(data: &[u8]) -> Option<u32> {
+    postcard::take_from_bytes::<u32>(data).ok().map(|(format, _)| format).filter(|&f| f != CHECKPOINT_FORMAT)
+}
+
+/// An error naming the jobs whose checkpoints hold packing work this version would throw away,
+/// and what to do; `Ok` when there are none.
+pub fn refuse_old_checkpoints(campaign: &str, old: &[OldCheckpoint]) -> anyhow::Result<()> {
+    if old.is_empty() {
+        return Ok(());
+    }
+    const SHOWN: usize = 5;
+    let mut named: Vec<String> = old
+        .iter()
+        .take(SHOWN)
+        .map(|c| match c.simulated_time {
+            Some(t) => format!("{} (format {}, at t = {t:.2} s)", c.job, c.format),
+            None => format!("{} (format {})", c.job, c.format),
+        })
+        .collect();
+    if old.len() > SHOWN {
+        named.push(format!("and {} more", old.len() - SHOWN));
+    }
+    Err(anyhow!(
+        "{campaign}: {} pending job(s) have a checkpoint written by another version of sedpack, which this \
+         version (checkpoint format {CHECKPOINT_FORMAT}) cannot continue: {}. Nothing was run and nothing was \
+         changed. To keep that packing work, resume with the sedpack that wrote the checkpoints; to start \
+         these jobs over, pass --discard-old-checkpoints",
+        old.len(),
+        named.join(", ")
+    ))
+}
+
+/// The campaign's pending jobs whose stored checkpoints this version cannot continue.
+pub async fn old_checkpoints(store: &Store, campaign: &str) -> anyhow::Result<Vec<OldCheckpoint>> {
+    let mut old = Vec::new();
+    for job in store.jobs(campaign).await?.into_iter().filter(|j| j.state == JobState::Pending) {
+        if let Some(checkpoint) = store.load_checkpoint(&job.id).await?
+            && let Some(format) = old_format(&checkpoint.data)
+        {
+            old.push(OldCheckpoint { job: job.id, format, simulated_time: Some(checkpoint.simulated_time) });
+        }
+    }
+    Ok(old)
 }
 
 /// What the runner did.
@@ -145,6 +206,7 @@ pub async fn run(store: &Store, campaign: &str, options: &RunOptions, interactiv
             id: worker_id(k),
             threads: per_worker,
             checkpoint_interval: options.checkpoint_interval,
+            discard_old_checkpoints: options.discard_old_checkpoints,
             cancel: cancel.clone(),
             bar,
             total: total.clone(),
@@ -181,6 +243,7 @@ struct Worker {
     id: String,
     threads: usize,
     checkpoint_interval: Duration,
+    discard_old_checkpoints: bool,
     cancel: Arc<AtomicBool>,
     bar: ProgressBar,
     total: ProgressBar,
@@ -265,6 +328,14 @@ impl Worker {
         pool: Arc<rayon::ThreadPool>,
     ) -> anyhow::Result<Outcome> {
         let checkpoint = self.store.load_checkpoint(job).await?;
+        // A job requeued during the run (its runner died) is checked here; the error returns it
+        // to pending with its checkpoint and stops the run.
+        if let Some(c) = checkpoint.as_ref().filter(|_| !self.discard_old_checkpoints)
+            && let Some(format) = old_format(&c.data)
+        {
+            let old = OldCheckpoint { job: job.to_string(), format, simulated_time: Some(c.simulated_time) };
+            refuse_old_checkpoints(&self.campaign, &[old])?;
+        }
         let (sender, mut receiver) = mpsc::channel(4);
         let stop = [self.cancel.clone(), Arc::new(AtomicBool::new(false))];
         let lost = stop[1].clone();

@@ -442,8 +442,21 @@ fn cancel_returns_the_jobs_to_pending_and_resume_continues() {
     assert!(out.contains("stop: 12 job(s) pending again"), "{out}");
     let status = json(&["status", "stop", "--db", db, "--json"]);
     assert_eq!((status["pending"].as_u64(), status["failed"].as_u64()), (Some(12), Some(0)), "{status}");
+    // One job's folder holds a checkpoint an older sedpack wrote (format 3): nothing is
+    // submitted until the user says to start that job over.
+    let runs = Path::new(db).with_extension("runs").join("stop");
+    let job =
+        std::fs::read_dir(&runs).unwrap().map(|e| e.unwrap().path()).find(|p| p.join("job.json").exists()).unwrap();
+    std::fs::write(job.join("checkpoint"), [3u8, 0x2a, 0x07]).unwrap();
+    let name = job.file_name().unwrap().to_str().unwrap();
+    let refused = sedpack_with_path(&std::env::var("PATH").unwrap(), &["run", &file, "--db", db, "--quiet"]);
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains(&format!("{name} (format 3)")) && stderr.contains("--discard-old-checkpoints"), "{stderr}");
+    assert_eq!(json(&["status", "stop", "--db", db, "--json"])["pending"].as_u64(), Some(12));
+    assert_eq!(std::fs::read(job.join("checkpoint")).unwrap(), [3u8, 0x2a, 0x07]);
     // The campaign keeps its executor, but not the hold.
-    let out = ok(&["run", &file, "--db", db, "--sbatch", "", "--wait", "--quiet"]);
+    let out = ok(&["run", &file, "--db", db, "--sbatch", "", "--wait", "--quiet", "--discard-old-checkpoints"]);
     assert!(out.contains("stop: 12 done"), "{out}");
     // A local campaign has nothing to cancel.
     let local = write(dir.path(), "here.yaml", &sphere_campaign("here", 0.02, ""));

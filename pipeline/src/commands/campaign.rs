@@ -10,7 +10,7 @@ use analysis::csv;
 use anyhow::{Context, bail};
 use serde::Serialize;
 use serde_json::{Map, Value};
-use store::{CampaignStatus, ExportRow, NewJob, Store, StoreError, StoredJob};
+use store::{CampaignStatus, ExportRow, JobState, NewJob, Store, StoreError, StoredJob};
 use tracing::info;
 
 use crate::campaign::{Campaign, read_campaign};
@@ -18,7 +18,7 @@ use crate::cli::{CancelArgs, ContinueArgs, ExportArgs, ResumeArgs, RunArgs, Stat
 use crate::executor::{Executor, Request};
 use crate::output::{Table, print_json};
 use crate::records::new_job;
-use crate::runner::{self, RunOptions, Summary};
+use crate::runner::{self, OldCheckpoint, RunOptions, Summary, old_format, refuse_old_checkpoints};
 use crate::slurm::{self, Followed, RunDir, Submission, TaskRow};
 use crate::{outln, stored};
 
@@ -210,8 +210,17 @@ async fn continue_campaign(
     let settings = match executor {
         Executor::Slurm(settings) => settings,
         Executor::Local => {
-            let options = RunOptions { workers: workers(workers_asked)?, checkpoint_interval };
+            let options = RunOptions {
+                workers: workers(workers_asked)?,
+                checkpoint_interval,
+                discard_old_checkpoints: common.discard_old_checkpoints,
+            };
             retry_failed(store, name, common.retry_failed).await?;
+            if !common.discard_old_checkpoints {
+                // All at once before anything starts; the workers check jobs requeued later.
+                runner::recover(store, name).await?;
+                refuse_old_checkpoints(name, &runner::old_checkpoints(store, name).await?)?;
+            }
             let summary = runner::run(store, name, &options, !common.quiet).await?;
             return report(name, summary, &store.status(name).await?).map_err(Into::into);
         }
@@ -219,6 +228,16 @@ async fn continue_campaign(
     let run = RunDir::of(db, name)?;
     slurm::sync(store, &run, name).await?;
     retry_failed(store, name, common.retry_failed).await?;
+    if !common.discard_old_checkpoints {
+        // The tasks run this binary and continue from the checkpoints in the run directory.
+        let mut old = Vec::new();
+        for job in store.jobs(name).await?.into_iter().filter(|j| j.state == JobState::Pending) {
+            if let Some(format) = std::fs::read(run.job(&job.id).checkpoint()).ok().and_then(|d| old_format(&d)) {
+                old.push(OldCheckpoint { job: job.id, format, simulated_time: None });
+            }
+        }
+        refuse_old_checkpoints(name, &old)?;
+    }
     let submission = Submission { store, run: &run, campaign: name, settings, checkpoint_interval };
     let arrays = submission.pending(None).await?;
     for a in &arrays {
