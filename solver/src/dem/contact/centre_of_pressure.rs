@@ -246,8 +246,9 @@ fn edge_normals(corners: &[V3; 3]) -> [V3; 3] {
 /// the tetrahedron where the wedges of the two faces on each edge meet. Its centroid if it is
 /// the overlap, else it is left in the cell; `None` if the wedges do not meet in one.
 fn edge_edge(a: &PolyhedronPose, ea: [u32; 2], b: &PolyhedronPose, eb: [u32; 2], d: &V3) -> Option<Tip> {
-    let wedge_a = Wedge::of(a, ea, &V3::zeros())?;
-    let wedge_b = Wedge::of(b, eb, d)?;
+    let (apices_a, apices_b) = (a.shape().edge_apices(ea[0], ea[1])?, b.shape().edge_apices(eb[0], eb[1])?);
+    let wedge_a = Wedge::of(a, ea, apices_a, &V3::zeros());
+    let wedge_b = Wedge::of(b, eb, apices_b, d);
     let (pa, ok_a) = wedge_b.crossings(&wedge_a.edge)?;
     let (pb, ok_b) = wedge_a.crossings(&wedge_b.edge)?;
     if ok_a && ok_b {
@@ -297,12 +298,14 @@ struct Wedge {
 }
 
 impl Wedge {
-    fn of(body: &PolyhedronPose, on: [u32; 2], center: &V3) -> Option<Self> {
-        let [r1, r2] = body.shape().edge_apices(on[0], on[1])?;
+    /// The wedge on edge `on` of `body` (centred at `center`), whose faces have the third
+    /// corners `apices` (the shape's edge apices; made here without an `Option`, which the
+    /// contact loop would copy).
+    fn of(body: &PolyhedronPose, on: [u32; 2], [r1, r2]: [u32; 2], center: &V3) -> Self {
         let (p, q) = (center + body.vertex(on[0]), center + body.vertex(on[1]));
         let faces = [[p, q, center + body.vertex(r1)], [p, center + body.vertex(r2), q]];
         let normals = faces.map(|c| (c[1] - c[0]).cross(&(c[2] - c[0])));
-        Some(Self { edge: [p, q], faces, normals })
+        Self { edge: [p, q], faces, normals }
     }
 
     /// Where the segment `edge` crosses the planes of the two faces, and whether each crossing

@@ -181,30 +181,27 @@ fn solve_polyhedra(
     let start = warm_normal.and_then(unit).or_else(|| unit(&d)).unwrap_or_else(V3::z);
     let mut far = None;
     let mut end = None;
-    let mut cso = match cached.and_then(|f| warm_tetrahedron(a, b, &d, &f)) {
+    let mut cso = match cached.map(|f| warm_tetrahedron(a, b, &d, &f)) {
         Some((tetrahedron, apex)) => {
-            stats.warm_features = true;
-            far = Some(apex);
             let p = &tetrahedron[0];
             let mut cso = Cso::warm(a, b, &start, p.vertex_a, p.vertex_b);
-            end = epa::confirm(&mut cso, &tetrahedron, GAP_POLYTOPE * reach, tiny).or_else(|| {
-                epa::expand(
-                    &mut cso,
-                    &tetrahedron,
-                    GAP_POLYTOPE * reach,
-                    VISIBLE * reach,
-                    tiny,
-                    &mut stats.epa_iterations,
-                )
-            });
-            stats.epa_iterations = stats.epa_iterations.max(1);
+            // A confirmed face has the origin strictly inside all four faces of the tetrahedron;
+            // only the expansion needs that checked.
+            end = epa::confirm(&mut cso, &tetrahedron, GAP_POLYTOPE * reach, tiny);
+            if end.is_none() && holds_origin(&tetrahedron) {
+                let (gap, visible) = (GAP_POLYTOPE * reach, VISIBLE * reach);
+                end = epa::expand(&mut cso, &tetrahedron, gap, visible, tiny, &mut stats.epa_iterations);
+            }
+            if end.is_some() {
+                stats.warm_features = true;
+                stats.epa_iterations = stats.epa_iterations.max(1);
+                far = Some(apex);
+            }
             cso
         }
         None => Cso::new(a, b, &start),
     };
     if end.is_none() {
-        far = None;
-        stats.warm_features = false;
         end = match gjk::overlap(&mut cso, &start, tiny, &mut stats.gjk_iterations) {
             Ok(simplex) => gjk::complete(&mut cso, simplex, tiny).and_then(|s| {
                 epa::expand(&mut cso, &s.p, GAP_POLYTOPE * reach, VISIBLE * reach, tiny, &mut stats.epa_iterations)
@@ -257,24 +254,27 @@ fn features_of(end: &Penetration, apex: (u32, u32)) -> Option<Kept> {
 }
 
 /// The tetrahedron of K at the current poses on the last step's features (B centred at `d`
-/// from A), with its far point's vertices, if it holds the origin strictly inside (then EPA may
-/// start from it).
-fn warm_tetrahedron(a: &PolyhedronPose, b: &PolyhedronPose, d: &V3, f: &Features) -> Option<([Point; 4], (u32, u32))> {
+/// from A), with its far point's vertices.
+fn warm_tetrahedron(a: &PolyhedronPose, b: &PolyhedronPose, d: &V3, f: &Features) -> ([Point; 4], (u32, u32)) {
     let p: [Point; 4] = std::array::from_fn(|k| {
         let (va, vb) = (u32::from(f.a[k]), u32::from(f.b[k]));
         let (pa, pb) = (a.vertex(va), b.vertex(vb) + d);
         Point { w: pa - pb, a: pa, b: pb, vertex_a: va, vertex_b: vb }
     });
+    (p, (u32::from(f.a[3]), u32::from(f.b[3])))
+}
+
+/// Whether the tetrahedron holds the origin strictly inside (then EPA may start from it).
+fn holds_origin(p: &[Point; 4]) -> bool {
     let volume = |a: &V3, b: &V3, c: &V3, d: &V3| (b - a).dot(&(c - a).cross(&(d - a)));
     let whole = volume(&p[0].w, &p[1].w, &p[2].w, &p[3].w);
     // The origin replacing corner k gives a volume of the whole's sign when it lies inside.
-    let inside = whole != 0.0
+    whole != 0.0
         && (0..4).all(|k| {
             let mut corners = [p[0].w, p[1].w, p[2].w, p[3].w];
             corners[k] = V3::zeros();
             volume(&corners[0], &corners[1], &corners[2], &corners[3]) * whole > 0.0
-        });
-    inside.then_some((p, (u32::from(f.a[3]), u32::from(f.b[3]))))
+        })
 }
 
 /// Contact of a polyhedron (body A) with an ellipsoid (body B), or `None` when they do not
