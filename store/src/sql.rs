@@ -97,15 +97,17 @@ pub const LOAD_CHECKPOINT: &str = "SELECT data, simulated_time, written_at FROM 
 pub const DELETE_CHECKPOINT: &str = "DELETE FROM checkpoints WHERE job_id = ?1";
 
 // Status and export
+// A done job's time is its packing's own over all its attempts (the result's); the job row
+// keeps only the last attempt's, which for a packing resumed from checkpoints is a part of it.
 pub const STATUS_COUNTS: &str = "
     SELECT COUNT(*),
-           COUNT(*) FILTER (WHERE state = 'pending'),
-           COUNT(*) FILTER (WHERE state = 'running'),
-           COUNT(*) FILTER (WHERE state = 'done'),
-           COUNT(*) FILTER (WHERE state = 'failed'),
-           TOTAL(wall_time) FILTER (WHERE state IN ('done', 'failed')),
-           AVG(wall_time) FILTER (WHERE state = 'done')
-    FROM jobs WHERE campaign_id = ?1";
+           COUNT(*) FILTER (WHERE jobs.state = 'pending'),
+           COUNT(*) FILTER (WHERE jobs.state = 'running'),
+           COUNT(*) FILTER (WHERE jobs.state = 'done'),
+           COUNT(*) FILTER (WHERE jobs.state = 'failed'),
+           TOTAL(COALESCE(results.wall_time, jobs.wall_time)) FILTER (WHERE jobs.state IN ('done', 'failed')),
+           AVG(COALESCE(results.wall_time, jobs.wall_time)) FILTER (WHERE jobs.state = 'done')
+    FROM jobs LEFT JOIN results ON results.job_id = jobs.id WHERE jobs.campaign_id = ?1";
 pub const FAILURES: &str = "
     SELECT id, attempts, error FROM jobs
     WHERE campaign_id = ?1 AND state = 'failed' ORDER BY rowid";

@@ -148,9 +148,10 @@ pub struct CampaignStatus {
     pub done: u64,
     pub failed: u64,
     pub failures: Vec<Failure>,
-    /// s of wall-clock time of the last attempt of every done or failed job, summed.
+    /// s of wall-clock time of every done or failed job, summed: a done job's packing time over
+    /// all its attempts (its result's), a failed job's last attempt.
     pub wall_time_finished: f64,
-    /// s per done job (last attempt), None before the first one is done.
+    /// s per done job (its packing time over all attempts), None before the first one is done.
     pub mean_wall_time_done: Option<f64>,
 }
 

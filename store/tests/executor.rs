@@ -6,6 +6,7 @@ mod common;
 
 use common::*;
 use serde_json::json;
+use sqlx::Connection;
 use store::{JobState, StoreError};
 
 #[tokio::test]
@@ -65,8 +66,14 @@ async fn a_running_job_is_handed_over_only_by_its_worker() {
     store.complete_ran(&job.id, "slurm:7_0", (100.0, 130.0), &result(0.4), &statistics(0.6)).await.unwrap();
     let again = store.complete_ran(&job.id, "slurm:7_0", (100.0, 130.0), &result(0.4), &[]).await;
     assert!(matches!(again, Err(StoreError::NotOwner { .. })), "a result is recorded once");
+    let mut raw = sqlx::SqliteConnection::connect(&format!("sqlite://{}", db_path(&dir).display())).await.unwrap();
+    let times: (f64, f64, f64) =
+        sqlx::query_as("SELECT started_at, finished_at, wall_time FROM jobs").fetch_one(&mut raw).await.unwrap();
+    assert_eq!(times, (100.0, 130.0, 30.0));
+    raw.close().await.unwrap();
+    // The status counts the packing's own time, which its result carries (42 s of packing).
     let status = store.status(CAMPAIGN).await.unwrap();
-    assert_eq!((status.done, status.mean_wall_time_done), (1, Some(30.0)));
+    assert_eq!((status.done, status.mean_wall_time_done), (1, Some(42.0)));
     let jobs = store.jobs(CAMPAIGN).await.unwrap();
     assert_eq!((jobs[0].state, jobs[0].worker_id.as_deref(), jobs[0].attempts), (JobState::Done, Some("slurm:7_0"), 1));
     store.close().await;
