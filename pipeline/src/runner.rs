@@ -81,8 +81,8 @@ pub fn refuse_old_checkpoints(campaign: &str, old: &[OldCheckpoint]) -> anyhow::
     }
     Err(anyhow!(
         "{campaign}: {} pending job(s) have a checkpoint written by another version of sedpack, which this \
-         version (checkpoint format {CHECKPOINT_FORMAT}) cannot continue: {}. Nothing was run and nothing was \
-         changed. To keep that packing work, resume with the sedpack that wrote the checkpoints; to start \
+         version (checkpoint format {CHECKPOINT_FORMAT}) cannot continue: {}. These jobs and their checkpoints \
+         are left as they were. To keep that packing work, resume with the sedpack that wrote the checkpoints; to start \
          these jobs over, pass --discard-old-checkpoints",
         old.len(),
         named.join(", ")
@@ -328,8 +328,8 @@ impl Worker {
         pool: Arc<rayon::ThreadPool>,
     ) -> anyhow::Result<Outcome> {
         let checkpoint = self.store.load_checkpoint(job).await?;
-        // A job requeued during the run (its runner died) is checked here; the error returns it
-        // to pending with its checkpoint and stops the run.
+        // `run`/`resume` checked the pending jobs before starting; this catches those taken over
+        // since (their runner died). The error returns the job to pending and stops the run.
         if let Some(c) = checkpoint.as_ref().filter(|_| !self.discard_old_checkpoints)
             && let Some(format) = old_format(&c.data)
         {

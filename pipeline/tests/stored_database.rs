@@ -34,7 +34,7 @@ fn a_database_of_version_0_1_0_resumes_and_reports_the_same_results() {
     assert_eq!((status["done"].as_u64(), status["pending"].as_u64()), (Some(3), Some(1)), "{status}");
     // The interrupted job's checkpoint is 0.1.0's, which this version cannot continue: resume
     // says so and changes nothing until asked to start that job over.
-    let notice = ["e4f0b397d28c4f59 (format 0, at t = ", "Nothing was run", "--discard-old-checkpoints"];
+    let notice = ["e4f0b397d28c4f59 (format 0, at t = ", "left as they were", "--discard-old-checkpoints"];
     common::fails(&["resume", "fixture", "--db", db, "--workers", "1", "--quiet"], &notice);
     assert_eq!(json(&["status", "fixture", "--db", db, "--json"]), status);
     let log = read(&dir.path().join("fixture.log"));
