@@ -832,11 +832,10 @@ impl Slab {
         slab.len = 0;
         slab.lo = V2::repeat(f64::INFINITY);
         slab.hi = V2::repeat(f64::NEG_INFINITY);
-        let height = |v: u32| axes[2].dot(&shape.vertices()[v as usize]) + shift.z;
         triangles_beyond(
             pose,
             &(frame.n * side),
-            |v| side * (height(v) - level) > 0.0,
+            |v| side * (at(v).z - level) > 0.0,
             |t| {
                 let p = shape.triangles()[t as usize].map(at);
                 let normal = frame.coordinates(&pose.normal(t));

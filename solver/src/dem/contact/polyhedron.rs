@@ -178,6 +178,7 @@ fn solve_polyhedra(
         return (None, Apart { gap: distance - reach, direction: d / distance }, stats, None);
     }
     let tiny = TOUCHING * reach;
+    let (polytope_gap, visible) = (GAP_POLYTOPE * reach, VISIBLE * reach);
     let start = warm_normal.and_then(unit).or_else(|| unit(&d)).unwrap_or_else(V3::z);
     let mut far = None;
     let mut end = None;
@@ -187,10 +188,9 @@ fn solve_polyhedra(
             let mut cso = Cso::warm(a, b, &start, p.vertex_a, p.vertex_b);
             // A confirmed face has the origin strictly inside all four faces of the tetrahedron;
             // only the expansion needs that checked.
-            end = epa::confirm(&mut cso, &tetrahedron, GAP_POLYTOPE * reach, tiny);
+            end = epa::confirm(&mut cso, &tetrahedron, polytope_gap, tiny);
             if end.is_none() && holds_origin(&tetrahedron) {
-                let (gap, visible) = (GAP_POLYTOPE * reach, VISIBLE * reach);
-                end = epa::expand(&mut cso, &tetrahedron, gap, visible, tiny, &mut stats.epa_iterations);
+                end = epa::expand(&mut cso, &tetrahedron, polytope_gap, visible, tiny, &mut stats.epa_iterations);
             }
             if end.is_some() {
                 stats.warm_features = true;
@@ -203,9 +203,8 @@ fn solve_polyhedra(
     };
     if end.is_none() {
         end = match gjk::overlap(&mut cso, &start, tiny, &mut stats.gjk_iterations) {
-            Ok(simplex) => gjk::complete(&mut cso, simplex, tiny).and_then(|s| {
-                epa::expand(&mut cso, &s.p, GAP_POLYTOPE * reach, VISIBLE * reach, tiny, &mut stats.epa_iterations)
-            }),
+            Ok(simplex) => gjk::complete(&mut cso, simplex, tiny)
+                .and_then(|s| epa::expand(&mut cso, &s.p, polytope_gap, visible, tiny, &mut stats.epa_iterations)),
             Err(u) => {
                 let apart = if mode == Mode::Coherent && u != V3::zeros() {
                     let (gap, direction) = gjk::separation(&mut cso, &u, tiny);
