@@ -35,6 +35,7 @@ pub struct Pair {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct NeighbourList {
     skin: f64,
+    /// Sorted by (i, j, contact key, pieces): a body's pairs as i are contiguous.
     pub pairs: Vec<Pair>,
     /// The contact history of each pair.
     pub history: Vec<ContactHistory>,
@@ -47,11 +48,13 @@ pub struct NeighbourList {
     /// Whole periods each body has been moved back into the box by since the start; a pair's
     /// image corrected by them identifies the same contact across rebuilds.
     wraps: Vec<[i32; 2]>,
-    /// Per body b, `entries[offsets[b]..split[b]]` are the pairs where it is i and
-    /// `entries[split[b]..offsets[b + 1]]` those where it is j: two loops without a branch.
-    offsets: Vec<u32>,
-    split: Vec<u32>,
-    entries: Vec<u32>,
+    /// Per body b, `as_j[first_as_j[b]..first_as_j[b + 1]]` are the pairs where it is j (those
+    /// where it is i are contiguous in `pairs`). Derived from `pairs`, so not kept in the state:
+    /// [`NeighbourList::index`] builds it anew after a restore.
+    #[serde(skip)]
+    first_as_j: Vec<u32>,
+    #[serde(skip)]
+    as_j: Vec<u32>,
     pub builds: u64,
 }
 
@@ -138,9 +141,8 @@ impl NeighbourList {
             reference: Vec::new(),
             reference_orientation: Vec::new(),
             wraps: Vec::new(),
-            offsets: vec![0],
-            split: Vec::new(),
-            entries: Vec::new(),
+            first_as_j: vec![0],
+            as_j: Vec::new(),
             builds: 0,
         }
     }
@@ -173,24 +175,29 @@ impl NeighbourList {
         size_of_val(&self.reference[..])
             + size_of_val(&self.reference_orientation[..])
             + size_of_val(&self.wraps[..])
-            + size_of_val(&self.offsets[..])
-            + size_of_val(&self.split[..])
+            + size_of_val(&self.first_as_j[..])
     }
 
-    /// Bytes held per listed pair: the pair, its history and cache, and its two index entries.
+    /// Bytes held per listed pair: the pair, its history and cache, and its index entry.
     pub fn pair_bytes(&self) -> usize {
         use std::mem::size_of_val;
         size_of_val(&self.pairs[..])
             + size_of_val(&self.history[..])
             + size_of_val(&self.cache[..])
-            + size_of_val(&self.entries[..])
+            + size_of_val(&self.as_j[..])
     }
 
-    /// Pairs of body `b`: those where it is i, and those where it is j.
+    /// Pairs in which body `b` is body j.
     #[inline]
-    pub fn pairs_of(&self, b: usize) -> (&[u32], &[u32]) {
-        let (start, split, end) = (self.offsets[b] as usize, self.split[b] as usize, self.offsets[b + 1] as usize);
-        (&self.entries[start..split], &self.entries[split..end])
+    pub fn pairs_as_j(&self, b: usize) -> &[u32] {
+        &self.as_j[self.first_as_j[b] as usize..self.first_as_j[b + 1] as usize]
+    }
+
+    /// Builds the index of pairs by body j for `n` bodies if it is missing (a restored list).
+    pub fn index(&mut self, n: usize, scratch: &mut BuildScratch) {
+        if self.first_as_j.len() != n + 1 {
+            self.index_by_body(n, &mut scratch.fill);
+        }
     }
 
     /// Rebuilds the list, in stages: wrap positions into the periodic box, bin bodies into
@@ -313,28 +320,22 @@ impl NeighbourList {
         }
     }
 
-    /// Lists each body's pairs: first those where it is i, then those where it is j.
+    /// Lists each body's pairs as body j, by a counting sort on j.
     fn index_by_body(&mut self, n: usize, cursor: &mut Vec<u32>) {
-        self.offsets.clear();
-        self.offsets.resize(n + 1, 0);
+        self.first_as_j.clear();
+        self.first_as_j.resize(n + 1, 0);
         for p in &self.pairs {
-            self.offsets[p.i as usize + 1] += 1;
-            self.offsets[p.j as usize + 1] += 1;
+            self.first_as_j[p.j as usize + 1] += 1;
         }
         for b in 0..n {
-            self.offsets[b + 1] += self.offsets[b];
+            self.first_as_j[b + 1] += self.first_as_j[b];
         }
-        self.entries.clear();
-        self.entries.resize(2 * self.pairs.len(), 0);
-        self.split.clear();
-        self.split.extend_from_slice(&self.offsets[..n]);
+        self.as_j.clear();
+        self.as_j.resize(self.pairs.len(), 0);
+        cursor.clear();
+        cursor.extend_from_slice(&self.first_as_j[..n]);
         for (k, p) in self.pairs.iter().enumerate() {
-            self.entries[self.split[p.i as usize] as usize] = k as u32;
-            self.split[p.i as usize] += 1;
-        }
-        cursor.clone_from(&self.split);
-        for (k, p) in self.pairs.iter().enumerate() {
-            self.entries[cursor[p.j as usize] as usize] = k as u32;
+            self.as_j[cursor[p.j as usize] as usize] = k as u32;
             cursor[p.j as usize] += 1;
         }
     }

@@ -18,7 +18,7 @@ use super::contact::{Mode, PairCache};
 use super::contact_law::{Calibration, ContactHistory, LinearSpringDashpot};
 use super::domain::Domain;
 use super::material::Material;
-use super::neighbours::{BuildScratch, NeighbourList};
+use super::neighbours::{BuildScratch, NeighbourList, Pair};
 use super::shape::{Pose, Shape};
 use crate::SolverError;
 use crate::fluid::{self, Fluid, FluidResponse};
@@ -57,14 +57,116 @@ impl Shaking {
     }
 }
 
-/// Force and torques of one pair contact: the force acts on body j, its opposite on body i,
-/// both at the contact point.
+/// What one pair contact leaves for body j: the force on it and its torque (the opposite force
+/// acts on body i at the same point, summed into i's [`Load`] where the pair is computed).
 #[derive(Debug, Clone, Copy, Default)]
 struct PairForce {
     force: Vector3<f64>,
-    torque_i: Vector3<f64>,
     torque_j: Vector3<f64>,
 }
+
+/// Force and torque on a body from the pairs in which it is body i.
+#[derive(Debug, Clone, Copy, Default)]
+struct Load {
+    force: Vector3<f64>,
+    torque: Vector3<f64>,
+}
+
+/// What the pair stage reads: the bodies, their poses of this step, the contact law.
+struct PairStage<'a> {
+    bodies: &'a Bodies,
+    domain: Domain,
+    poses: &'a [Pose],
+    law: &'a LinearSpringDashpot,
+    dt: f64,
+}
+
+impl PairStage<'_> {
+    /// The pairs of bodies `first..first + loads.len()` as body i (listed by i), halved at a
+    /// body until a task holds few pairs; the halves are the same whatever the threads, so
+    /// every sum is too.
+    fn run(
+        &self,
+        first: usize,
+        pairs: &[Pair],
+        history: &mut [ContactHistory],
+        cache: &mut [PairCache],
+        out: &mut [PairForce],
+        loads: &mut [Load],
+    ) -> (usize, f64) {
+        if pairs.len() > PAIRS_PER_TASK && loads.len() > 1 {
+            let half = loads.len() / 2;
+            let cut = pairs.partition_point(|p| (p.i as usize) < first + half);
+            let (pairs_a, pairs_b) = pairs.split_at(cut);
+            let (history_a, history_b) = history.split_at_mut(cut);
+            let (cache_a, cache_b) = cache.split_at_mut(cut);
+            let (out_a, out_b) = out.split_at_mut(cut);
+            let (loads_a, loads_b) = loads.split_at_mut(half);
+            let (a, b) = rayon::join(
+                || self.run(first, pairs_a, history_a, cache_a, out_a, loads_a),
+                || self.run(first + half, pairs_b, history_b, cache_b, out_b, loads_b),
+            );
+            return (a.0 + b.0, a.1.max(b.1));
+        }
+        let (mut open, mut worst) = (0, 0.0f64);
+        for (((pair, history), cache), out) in pairs.iter().zip(history).zip(cache).zip(out) {
+            let Some(Touch { force, arm_i, arm_j, overlap }) = self.contact(pair, history, cache) else {
+                history.tangential_displacement = Vector3::zeros();
+                *out = PairForce::default();
+                continue;
+            };
+            let load = &mut loads[pair.i as usize - first];
+            load.force -= force;
+            load.torque += force.cross(&arm_i);
+            *out = PairForce { force, torque_j: arm_j.cross(&force) };
+            open += 1;
+            worst = worst.max(overlap);
+        }
+        (open, worst)
+    }
+
+    /// The pair's contact this step, if open.
+    #[inline(always)]
+    fn contact(&self, pair: &Pair, history: &mut ContactHistory, cache: &mut PairCache) -> Option<Touch> {
+        let bodies = self.bodies;
+        let (i, j) = (pair.i as usize, pair.j as usize);
+        let xi = bodies.position[i];
+        let xj = bodies.position[j] + self.domain.shift(pair.image);
+        let (geometry, scale) = if pair.spheres {
+            // Sphere beds spend most of their time here: no shape to load, no piece to build.
+            let (ra, rb) = (bodies.bounding_radius[i], bodies.bounding_radius[j]);
+            (contact::sphere::sphere_sphere(&xi, ra, &xj, rb)?, ra.min(rb))
+        } else {
+            let travel = bodies.travel[i] + bodies.travel[j];
+            if cache.still_apart(travel) {
+                return None;
+            }
+            let [ka, kb] = pair.pieces.map(usize::from);
+            let a = bodies.shape[i].piece(ka, xi, &bodies.orientation[i], &self.poses[i]);
+            let b = bodies.shape[j].piece(kb, xj, &bodies.orientation[j], &self.poses[j]);
+            let scale = a.smallest_half_extent().min(b.smallest_half_extent());
+            (contact::between(&a, &b, cache, travel, Mode::Coherent)?, scale)
+        };
+        let arm_i = geometry.point - xi;
+        let arm_j = geometry.point - xj;
+        let relative = bodies.point_velocity(j, &arm_j) - bodies.point_velocity(i, &arm_i);
+        let force = self.law.force(pair.effective_mass, &geometry, &relative, history, self.dt);
+        Some(Touch { force, arm_i, arm_j, overlap: geometry.depth / scale })
+    }
+}
+
+/// An open pair contact: the force on body j (its opposite acts on i), the arms from i's and
+/// j's centres to the contact point, and the overlap relative to the smaller half-extent.
+struct Touch {
+    force: Vector3<f64>,
+    arm_i: Vector3<f64>,
+    arm_j: Vector3<f64>,
+    overlap: f64,
+}
+
+/// Pairs above which the pair stage splits a task in two: a task of sphere contacts then lasts
+/// a few microseconds, long beside what splitting costs.
+const PAIRS_PER_TASK: usize = 256;
 
 /// The narrow phase's shortcuts against the full query over one step's pairs
 /// ([`Simulation::audit_next_step`]).
@@ -177,8 +279,10 @@ pub struct Simulation {
 /// The working memory of a step: overwritten every step, never part of the state.
 #[derive(Debug, Clone, Default)]
 struct Pipeline {
-    /// Force and torques of each listed pair.
+    /// What each listed pair leaves for its body j.
     pair_forces: Vec<PairForce>,
+    /// Each body's load from the pairs in which it is body i.
+    loads: Vec<Load>,
     /// What the narrow phase precomputes of each body for this step.
     poses: Vec<Pose>,
     /// The neighbour list's cell grid and previous list.
@@ -240,6 +344,8 @@ impl Simulation {
         let start = Instant::now();
         if self.neighbours.is_stale(&self.bodies) {
             self.neighbours.rebuild(&mut self.bodies, &self.domain, &mut self.pipeline.build)?;
+        } else {
+            self.neighbours.index(self.bodies.len(), &mut self.pipeline.build);
         }
         self.pose_bodies();
         let after_neighbours = Instant::now();
@@ -336,56 +442,18 @@ impl Simulation {
     }
 
     /// Narrow phase and contact law for every listed pair; returns the number of open contacts
-    /// and the largest overlap relative to the pair's smaller half-extent.
+    /// and the largest overlap relative to the pair's smaller half-extent. Each body's load as
+    /// body i is summed where its pairs are computed (they are listed by i); only body j's share
+    /// of a pair waits in `pair_forces` for the next stage.
     fn pair_contacts(&mut self) -> (usize, f64) {
-        let bodies = &self.bodies;
-        let domain = self.domain;
-        let poses = &self.pipeline.poses;
-        let law = &self.law;
-        let dt = self.settings.time_step;
-        self.pipeline.pair_forces.resize(self.neighbours.pairs.len(), PairForce::default());
-        let pairs = &self.neighbours.pairs;
-        pairs
-            .par_iter()
-            .zip(self.neighbours.history.par_iter_mut())
-            .zip(self.neighbours.cache.par_iter_mut())
-            .zip(self.pipeline.pair_forces.par_iter_mut())
-            .map(|(((pair, history), cache), out)| {
-                let (i, j) = (pair.i as usize, pair.j as usize);
-                let (geometry, scale) = if pair.spheres {
-                    // Sphere beds spend most of their time here: no shape to load, no piece to build.
-                    let xi = bodies.position[i];
-                    let xj = bodies.position[j] + domain.shift(pair.image);
-                    let (ra, rb) = (bodies.bounding_radius[i], bodies.bounding_radius[j]);
-                    (contact::sphere::sphere_sphere(&xi, ra, &xj, rb), ra.min(rb))
-                } else {
-                    let travel = bodies.travel[i] + bodies.travel[j];
-                    if cache.still_apart(travel) {
-                        history.tangential_displacement = Vector3::zeros();
-                        *out = PairForce::default();
-                        return (0, 0.0);
-                    }
-                    let xi = bodies.position[i];
-                    let xj = bodies.position[j] + domain.shift(pair.image);
-                    let [ka, kb] = pair.pieces.map(usize::from);
-                    let a = bodies.shape[i].piece(ka, xi, &bodies.orientation[i], &poses[i]);
-                    let b = bodies.shape[j].piece(kb, xj, &bodies.orientation[j], &poses[j]);
-                    let scale = a.smallest_half_extent().min(b.smallest_half_extent());
-                    (contact::between(&a, &b, cache, travel, Mode::Coherent), scale)
-                };
-                let Some(geometry) = geometry else {
-                    history.tangential_displacement = Vector3::zeros();
-                    *out = PairForce::default();
-                    return (0, 0.0);
-                };
-                let arm_i = geometry.point - bodies.position[i];
-                let arm_j = geometry.point - (bodies.position[j] + domain.shift(pair.image));
-                let relative = bodies.point_velocity(j, &arm_j) - bodies.point_velocity(i, &arm_i);
-                let force = law.force(pair.effective_mass, &geometry, &relative, history, dt);
-                *out = PairForce { force, torque_i: force.cross(&arm_i), torque_j: arm_j.cross(&force) };
-                (1, geometry.depth / scale)
-            })
-            .reduce(|| (0, 0.0), |a, b| (a.0 + b.0, a.1.max(b.1)))
+        let Pipeline { pair_forces, loads, poses, .. } = &mut self.pipeline;
+        pair_forces.resize(self.neighbours.pairs.len(), PairForce::default());
+        loads.clear();
+        loads.resize(self.bodies.len(), Load::default());
+        let stage =
+            PairStage { bodies: &self.bodies, domain: self.domain, poses, law: &self.law, dt: self.settings.time_step };
+        let list = &mut self.neighbours;
+        stage.run(0, &list.pairs, &mut list.history, &mut list.cache, pair_forces, loads)
     }
 
     /// Per body: wall contacts, the sum of its pair forces, external forces, then the
@@ -397,6 +465,7 @@ impl Simulation {
         let domain = self.domain;
         let neighbours = &self.neighbours;
         let pair_forces = &self.pipeline.pair_forces;
+        let loads = &self.pipeline.loads;
         let poses = &self.pipeline.poses;
         let dt = settings.time_step;
         let weight_per_volume = settings.material.weight_per_volume();
@@ -418,20 +487,15 @@ impl Simulation {
                 let shape = &b.shape[k];
                 let pose = &poses[k];
                 let mass = b.mass[k];
-                let mut force = weight_per_volume * b.volume[k] + Vector3::new(mass * shaking, 0.0, 0.0);
-                let mut torque = Vector3::zeros();
+                let mut force =
+                    weight_per_volume * b.volume[k] + Vector3::new(mass * shaking, 0.0, 0.0) + loads[k].force;
+                let mut torque = loads[k].torque;
                 if let Some(responses) = fluid {
                     let (f, t) = responses[k].load(v, w);
                     force += f;
                     torque += t;
                 }
-                let (as_i, as_j) = neighbours.pairs_of(k);
-                for &pair in as_i {
-                    let pf = &pair_forces[pair as usize];
-                    force -= pf.force;
-                    torque += pf.torque_i;
-                }
-                for &pair in as_j {
+                for &pair in neighbours.pairs_as_j(k) {
                     let pf = &pair_forces[pair as usize];
                     force += pf.force;
                     torque += pf.torque_j;
@@ -522,7 +586,12 @@ impl Simulation {
         }
         let pipeline = &self.pipeline;
         Memory {
-            bodies: arrays + shapes + walls + self.neighbours.body_bytes() + size_of_val(&pipeline.poses[..]),
+            bodies: arrays
+                + shapes
+                + walls
+                + self.neighbours.body_bytes()
+                + size_of_val(&pipeline.poses[..])
+                + size_of_val(&pipeline.loads[..]),
             pairs: self.neighbours.pair_bytes() + size_of_val(&pipeline.pair_forces[..]),
             shared_meshes: meshes.iter().map(|m| m.heap_bytes()).sum(),
         }
