@@ -14,6 +14,7 @@ use analysis::selection::SelectionOptions;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde_json::json;
+use solver::fabric::Imbrication;
 use solver::porosity::ProfilePoint;
 
 /// Grains of a packing: FL and EL on a 4 × 4 grid at μ ± 0.5σ, ± 1.5σ, clipped to [0.1, 1]
@@ -391,6 +392,64 @@ fn a_campaign_with_and_without_drag_compares_them_seed_by_seed() {
     assert!(md.contains("| all jobs | buoyancy only | 3 | 0.3500 | 0.0082 | — |"), "{md}");
     assert!(
         md.contains("| all jobs | drag and lift, still water | 4 | 0.3770 | 0.0097 | +0.0223 ± 0.0015 (3 pairs) |"),
+        "{md}"
+    );
+    check_html(out.path(), 0);
+}
+
+/// Packings in still water and under a current: the imbrication per setup, worked by hand.
+#[test]
+fn the_imbrication_of_each_setup_is_summed_over_its_runs() {
+    let fabric = |upstream: f64, direction: f64, length: f64| Imbrication {
+        grains: 100,
+        dip: vec![0.0; solver::fabric::DIP_BINS],
+        direction: vec![0.0; solver::fabric::DIRECTION_BINS],
+        mean_dip: 18.0,
+        upstream,
+        resultant_direction: direction,
+        resultant_length: length,
+    };
+    let runs = [
+        ("drag and lift, still water", 0.0, vec![fabric(0.5, 0.0, 0.1), fabric(0.4, 90.0, 0.1)]),
+        (
+            "drag and lift, logarithmic current",
+            0.05,
+            vec![fabric(0.70, 170.0, 0.4), fabric(0.74, -170.0, 0.4), fabric(0.72, 180.0, 0.5)],
+        ),
+    ];
+    let mut records = Vec::new();
+    for (fluid, shear_velocity, fabrics) in runs {
+        for (seed, f) in fabrics.into_iter().enumerate() {
+            records.push(JobRecord {
+                job_id: format!("{shear_velocity}-{seed}"),
+                porosity: 0.37,
+                profile: vec![],
+                parameters: BTreeMap::from([
+                    ("fluid.flow.shear_velocity".into(), json!(shear_velocity)),
+                    ("seed".into(), json!(seed + 1)),
+                ]),
+                grain_statistics: grain_statistics(&[(0.8, 0.5); 3]),
+                experiment: None,
+                fluid: Some(fluid.into()),
+                imbrication: Some(f),
+            });
+        }
+    }
+    let out = tempfile::tempdir().unwrap();
+    let files = report("imbrication", &records, out.path());
+    let md = std::fs::read_to_string(&files.markdown).unwrap();
+    // Still water: 50 % and 40 % upstream, mean 45, population std 5; resultants 0.1 at 0° and
+    // 0.1 at 90° add to (0.1, 0.1): 45°, length 0.1414/2 = 0.071. Current: 70, 74, 72 %, mean
+    // 72, std √(8/3) = 1.63; 0.4 at ±170° and 0.5 at 180° add to (−0.4·2·cos 10° − 0.5, 0) =
+    // (−1.288, 0): 180°, length 1.288/3 = 0.429; lengths 0.4, 0.4, 0.5, mean 0.433.
+    assert!(
+        md.contains("| all jobs | drag and lift, still water | 2 | 45.0 ± 5.0 | 45 (0.07) | 0.10 (0.10–0.10) |"),
+        "{md}"
+    );
+    assert!(
+        md.contains(
+            "| all jobs | drag and lift, logarithmic current | 3 | 72.0 ± 1.6 | 180 (0.43) | 0.43 (0.40–0.50) |"
+        ),
         "{md}"
     );
     check_html(out.path(), 0);

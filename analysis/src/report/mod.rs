@@ -11,6 +11,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use serde_json::Value;
+use solver::fabric::Imbrication;
 use thiserror::Error;
 
 use crate::campaign::{Analysis, PACKINGS_PER_FEATURE, Support};
@@ -496,7 +497,7 @@ fn fluid_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
         "Packings deposited with the fluid forces of Sun & Xiao (§2.3: drag per component sphere after Syamlal et al., Eqs. 3–7, with the local fluid fraction; Saffman lift, Eq. 8) in a prescribed flow, beside those deposited with buoyancy only (the first paper's protocol). Runs that differ only in seed are grouped; the setup lists the other varied parameters.".into(),
     ));
     let fluid_key = |k: &str| k == "seed" || k == "process.fluid" || k.starts_with("fluid.");
-    let mut groups: Vec<(String, String, Vec<SeededRun>)> = Vec::new();
+    let mut groups: Vec<(String, String, Vec<&JobRecord>)> = Vec::new();
     for r in records {
         let setup: Vec<String> = r
             .parameters
@@ -506,20 +507,22 @@ fn fluid_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
             .collect();
         let setup = if setup.is_empty() { "all jobs".to_string() } else { setup.join(", ") };
         let fluid = r.fluid.clone().unwrap_or_else(|| DRY.into());
-        let run = (r.parameters.get("seed").map(value_text), r.porosity);
         match groups.iter_mut().find(|g| g.0 == setup && g.1 == fluid) {
-            Some(g) => g.2.push(run),
-            None => groups.push((setup, fluid, vec![run])),
+            Some(g) => g.2.push(r),
+            None => groups.push((setup, fluid, vec![r])),
         }
     }
     groups.sort_by(|a, b| a.0.cmp(&b.0));
+    let seeded = |runs: &[&JobRecord]| -> Vec<SeededRun> {
+        runs.iter().map(|r| (r.parameters.get("seed").map(value_text), r.porosity)).collect()
+    };
     let rows = groups
         .iter()
         .map(|(setup, fluid, runs)| {
-            let porosities: Vec<f64> = runs.iter().map(|r| r.1).collect();
+            let porosities: Vec<f64> = runs.iter().map(|r| r.porosity).collect();
             let (mean, std) = mean_std(&porosities);
             let dry = groups.iter().find(|g| g.0 == *setup && g.1 == DRY).filter(|_| fluid != DRY);
-            let paired = dry.map_or("—".to_string(), |dry| paired_difference(runs, &dry.2));
+            let paired = dry.map_or("—".to_string(), |dry| paired_difference(&seeded(runs), &seeded(&dry.2)));
             vec![
                 setup.clone(),
                 fluid.clone(),
@@ -549,6 +552,22 @@ fn fluid_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
     blocks.push(Block::Paragraph(
         "The grains' long axes against the flow (+x): the dip is the angle between the long axis and the horizontal; its direction is the azimuth, from the flow direction, of the end that points down, so 180° means the axis dips upstream, leaning against the current as imbricated gravel does. The resultant is the mean of the dip directions weighted by the sine of the dip: its length runs from 0 (no preferred direction) to 1 (all alike).".into(),
     ));
+    blocks.push(Block::Paragraph(
+        "Per setup: the share of grains dipping upstream (mean ± population standard deviation over the runs); the runs' resultants added as vectors and divided by their number, its direction and, in brackets, its length (near 0 when the runs point different ways, however long each is); and the runs' resultant lengths (mean, least–greatest).".into(),
+    ));
+    let summaries = groups
+        .iter()
+        .filter_map(|(setup, fluid, runs)| {
+            let fabrics: Vec<&Imbrication> = runs.iter().filter_map(|r| r.imbrication.as_ref()).collect();
+            (!fabrics.is_empty()).then(|| imbrication_row(setup, fluid, &fabrics))
+        })
+        .collect();
+    blocks.push(Block::Table {
+        header: ["setup", "fluid", "runs", "dipping upstream (%)", "mean resultant (°)", "resultant lengths"]
+            .map(String::from)
+            .to_vec(),
+        rows: summaries,
+    });
     let percent = |x: f64| format!("{:.0}", 100.0 * x);
     blocks.push(Block::Table {
         header: [
@@ -602,6 +621,27 @@ fn fluid_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
         (0..solver::fabric::DIRECTION_BINS).map(|k| format!("{}", 30 * k)).collect(),
         |r| &r.imbrication.as_ref().expect("filtered").direction,
     ));
+}
+
+/// One setup's imbrication over its runs: upstream share, mean resultant vector, lengths.
+fn imbrication_row(setup: &str, fluid: &str, fabrics: &[&Imbrication]) -> Vec<String> {
+    let upstream: Vec<f64> = fabrics.iter().map(|f| 100.0 * f.upstream).collect();
+    let (mean, std) = mean_std(&upstream);
+    let (x, y) = fabrics.iter().fold((0.0, 0.0), |(x, y), f| {
+        let a = f.resultant_direction.to_radians();
+        (x + f.resultant_length * a.cos(), y + f.resultant_length * a.sin())
+    });
+    let lengths: Vec<f64> = fabrics.iter().map(|f| f.resultant_length).collect();
+    let (least, greatest) =
+        lengths.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &l| (lo.min(l), hi.max(l)));
+    vec![
+        setup.to_string(),
+        fluid.to_string(),
+        fabrics.len().to_string(),
+        format!("{mean:.1} ± {std:.1}"),
+        format!("{:.0} ({:.2})", y.atan2(x).to_degrees(), x.hypot(y) / fabrics.len() as f64),
+        format!("{:.2} ({least:.2}–{greatest:.2})", mean_std(&lengths).0),
+    ]
 }
 
 fn dataset_section(blocks: &mut Vec<Block>, d: &Dataset) {
