@@ -62,17 +62,27 @@ pub struct NeighbourList {
 #[derive(Debug, Clone, Default)]
 pub struct BuildScratch {
     cell_start: Vec<u32>,
-    cell_bodies: Vec<u32>,
+    /// The bodies of each cell with what the pair search reads of them, cell after cell.
+    cell_bodies: Vec<Member>,
     cell_of: Vec<usize>,
     fill: Vec<u32>,
     old_pairs: Vec<Pair>,
     old_history: Vec<ContactHistory>,
     old_cache: Vec<PairCache>,
     old_keys: Vec<[i32; 2]>,
+    radii: Vec<f64>,
 }
 
-/// The cell grid of one build: periodic directions with fewer than three cells collapse to one,
-/// so that the 27 neighbour cells of a cell are always distinct.
+/// A body as the pair search reads it from its cell: index, bounding radius and position.
+#[derive(Debug, Clone, Copy, Default)]
+struct Member {
+    body: u32,
+    radius: f64,
+    position: Vector3<f64>,
+}
+
+/// The cell grid of one build, with cells as wide as a typical body's reach: a body looks for
+/// partners no larger than itself in the cells its own reach spans.
 struct Grid {
     n: [usize; 3],
     origin: Vector3<f64>,
@@ -81,14 +91,11 @@ struct Grid {
 }
 
 impl Grid {
-    fn new(domain: &Domain, cutoff: f64, z_range: (f64, f64)) -> Self {
+    fn new(domain: &Domain, cell: f64, z_range: (f64, f64)) -> Self {
         let l = domain.width();
-        let mut nxy = (l / cutoff).floor().max(1.0) as usize;
-        if domain.is_periodic() && nxy < 3 {
-            nxy = 1;
-        }
-        let height = (z_range.1 - z_range.0).max(cutoff);
-        let nz = (height / cutoff).floor().max(1.0) as usize;
+        let nxy = (l / cell).floor().max(1.0) as usize;
+        let height = (z_range.1 - z_range.0).max(cell);
+        let nz = (height / cell).floor().max(1.0) as usize;
         Grid {
             n: [nxy, nxy, nz],
             origin: Vector3::new(0.0, 0.0, z_range.0),
@@ -110,24 +117,26 @@ impl Grid {
         self.n.iter().product()
     }
 
-    /// The neighbour cell at offset `d` (−1, 0, 1 per axis), or None outside a non-periodic edge.
-    fn neighbour(&self, c: [usize; 3], d: [i64; 3]) -> Option<[usize; 3]> {
-        let mut out = [0; 3];
-        for k in 0..3 {
-            let n = self.n[k] as i64;
-            if n == 1 && d[k] != 0 {
-                return None;
-            }
-            let v = c[k] as i64 + d[k];
-            out[k] = if (0..n).contains(&v) {
-                v as usize
-            } else if self.periodic && k < 2 {
-                v.rem_euclid(n) as usize
+    /// The cells along axis `k` within `reach` of a point in cell `c`, each once: a periodic axis
+    /// wraps around (all its cells once the reach spans it), a bounded one stops at its ends.
+    fn axis(&self, k: usize, c: usize, reach: f64) -> impl Iterator<Item = usize> + use<> {
+        let (n, c, span) = (self.n[k] as i64, c as i64, (reach / self.width[k]).ceil() as i64);
+        let wraps = self.periodic && k < 2;
+        let (lo, hi) = match wraps {
+            true if 2 * span + 1 >= n => (0, n - 1),
+            true => (c - span, c + span),
+            false => ((c - span).max(0), (c + span).min(n - 1)),
+        };
+        // The wrapped range reaches less than one period past either end.
+        (lo..=hi).map(move |v| {
+            (if v < 0 {
+                v + n
+            } else if v >= n {
+                v - n
             } else {
-                return None;
-            };
-        }
-        Some(out)
+                v
+            }) as usize
+        })
     }
 }
 
@@ -213,7 +222,7 @@ impl NeighbourList {
         scratch.old_keys.clear();
         scratch.old_keys.extend(self.pairs.iter().map(|p| contact_key(p, &self.wraps)));
         self.wrap(bodies, domain);
-        let grid = self.grid(bodies, domain)?;
+        let grid = self.grid(bodies, domain, &mut scratch.radii)?;
         scratch.bin(bodies, &grid);
         std::mem::swap(&mut self.pairs, &mut scratch.old_pairs);
         std::mem::swap(&mut self.history, &mut scratch.old_history);
@@ -238,8 +247,9 @@ impl NeighbourList {
         }
     }
 
-    /// The cell grid for the bodies' current extent, with cells as wide as the longest reach.
-    fn grid(&self, bodies: &Bodies, domain: &Domain) -> Result<Grid, SolverError> {
+    /// The cell grid for the bodies' current extent, with cells as wide as the median body's
+    /// reach (twice its bounding radius plus the skin), but no more than a few cells per body.
+    fn grid(&self, bodies: &Bodies, domain: &Domain, radii: &mut Vec<f64>) -> Result<Grid, SolverError> {
         let r_max = bodies.bounding_radius.iter().cloned().fold(0.0, f64::max);
         let cutoff = 2.0 * r_max + self.skin;
         // A grain must not reach its own periodic image; up to that, a pair may touch through
@@ -249,45 +259,47 @@ impl NeighbourList {
         }
         let (z_lo, z_hi) =
             bodies.position.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.z), hi.max(p.z)));
-        Ok(Grid::new(domain, cutoff, if bodies.is_empty() { (0.0, cutoff) } else { (z_lo, z_hi) }))
+        let z_range = if bodies.is_empty() { (0.0, cutoff) } else { (z_lo, z_hi) };
+        radii.clear();
+        radii.extend_from_slice(&bodies.bounding_radius);
+        let half = radii.len() / 2;
+        let median = if radii.is_empty() { r_max } else { *radii.select_nth_unstable_by(half, f64::total_cmp).1 };
+        // Bodies spread thin (grains raining down a tall column) would leave most cells empty.
+        let volume = domain.width().powi(2) * (z_range.1 - z_range.0);
+        let sparse = (volume / (4.0 * bodies.len().max(1) as f64)).cbrt();
+        Ok(Grid::new(domain, (2.0 * median + self.skin).max(sparse), z_range))
     }
 
-    /// Every pair of pieces within reach, in the order (i, j, contact key, pieces).
+    /// Every pair of pieces within reach, in the order (i, j, contact key, pieces). Each body
+    /// looks for the partners no larger than itself (ties to the lower index) in the cells its
+    /// reach spans, so that a few large grains do not make every small one search their range.
     fn list_pairs(&mut self, bodies: &Bodies, domain: &Domain, grid: &Grid, s: &BuildScratch) {
         self.pairs.clear();
-        for i in 0..bodies.len() {
-            let xi = bodies.position[i];
+        let radius = &bodies.bounding_radius;
+        let (l, periodic) = (domain.width(), domain.is_periodic());
+        // Positions are in the box, so a component of a separation is within ±l and the nearest
+        // image is at most one period away; beyond reach there, it is beyond reach everywhere.
+        let nearest = |d: f64| match periodic {
+            true if d > 0.5 * l => d - l,
+            true if d < -0.5 * l => d + l,
+            _ => d,
+        };
+        for (i, (&xi, &ri)) in bodies.position.iter().zip(radius).enumerate() {
             let ci = grid.coordinates(&xi);
-            for dz in -1..=1 {
-                for dy in -1..=1 {
-                    for dx in -1..=1 {
-                        let Some(cj) = grid.neighbour(ci, [dx, dy, dz]) else { continue };
-                        let c = grid.index(cj);
-                        for &j in &s.cell_bodies[s.cell_start[c] as usize..s.cell_start[c + 1] as usize] {
-                            let j = j as usize;
-                            if j <= i {
+            let search = 2.0 * ri + self.skin;
+            for cz in grid.axis(2, ci[2], search) {
+                for cy in grid.axis(1, ci[1], search) {
+                    for cx in grid.axis(0, ci[0], search) {
+                        let c = grid.index([cx, cy, cz]);
+                        for m in &s.cell_bodies[s.cell_start[c] as usize..s.cell_start[c + 1] as usize] {
+                            let other = m.body as usize;
+                            if m.radius > ri || (m.radius == ri && other <= i) {
                                 continue;
                             }
-                            let reach = bodies.bounding_radius[i] + bodies.bounding_radius[j] + self.skin;
-                            let (mi, mj) = (bodies.mass[i], bodies.mass[j]);
-                            let effective_mass = mi * mj / (mi + mj);
-                            for image in domain.images_within(&xi, &bodies.position[j], reach) {
-                                let xj = bodies.position[j] + domain.shift(image);
-                                if (xj - xi).norm_squared() < reach * reach {
-                                    let spheres = matches!(
-                                        (&bodies.shape[i], &bodies.shape[j]),
-                                        (Shape::Sphere { .. }, Shape::Sphere { .. })
-                                    );
-                                    let body_pair = Pair {
-                                        i: i as u32,
-                                        j: j as u32,
-                                        image,
-                                        pieces: [0, 0],
-                                        spheres,
-                                        effective_mass,
-                                    };
-                                    push_piece_pairs(&mut self.pairs, body_pair, bodies, xj, self.skin);
-                                }
+                            let d = m.position - xi;
+                            let reach = ri + m.radius + self.skin;
+                            if nearest(d.x).powi(2) + nearest(d.y).powi(2) + d.z * d.z < reach * reach {
+                                self.list_pair(bodies, domain, i.min(other), i.max(other));
                             }
                         }
                     }
@@ -296,6 +308,23 @@ impl NeighbourList {
         }
         let wraps = &self.wraps;
         self.pairs.sort_unstable_by_key(|p| (p.i, p.j, contact_key(p, wraps), p.pieces));
+    }
+
+    /// Lists bodies i < j for every periodic image of j within reach of i.
+    fn list_pair(&mut self, bodies: &Bodies, domain: &Domain, i: usize, j: usize) {
+        let xi = bodies.position[i];
+        let reach = bodies.bounding_radius[i] + bodies.bounding_radius[j] + self.skin;
+        let (mi, mj) = (bodies.mass[i], bodies.mass[j]);
+        let effective_mass = mi * mj / (mi + mj);
+        for image in domain.images_within(&xi, &bodies.position[j], reach) {
+            let xj = bodies.position[j] + domain.shift(image);
+            if (xj - xi).norm_squared() < reach * reach {
+                let spheres =
+                    matches!((&bodies.shape[i], &bodies.shape[j]), (Shape::Sphere { .. }, Shape::Sphere { .. }));
+                let body_pair = Pair { i: i as u32, j: j as u32, image, pieces: [0, 0], spheres, effective_mass };
+                push_piece_pairs(&mut self.pairs, body_pair, bodies, xj, self.skin);
+            }
+        }
     }
 
     /// Gives each listed pair the history and cache it had in the previous list, if it was
@@ -355,10 +384,11 @@ impl BuildScratch {
             self.cell_start[c + 1] += self.cell_start[c];
         }
         self.cell_bodies.clear();
-        self.cell_bodies.resize(bodies.len(), 0);
+        self.cell_bodies.resize(bodies.len(), Member::default());
         self.fill.clone_from(&self.cell_start);
         for (b, &c) in self.cell_of.iter().enumerate() {
-            self.cell_bodies[self.fill[c] as usize] = b as u32;
+            let (radius, position) = (bodies.bounding_radius[b], bodies.position[b]);
+            self.cell_bodies[self.fill[c] as usize] = Member { body: b as u32, radius, position };
             self.fill[c] += 1;
         }
     }
@@ -414,6 +444,56 @@ mod tests {
             b.push(body, 2650.0);
         }
         b
+    }
+
+    /// Every pair within reach by brute force: each pair of bodies, each periodic image.
+    fn all_pairs_within_reach(b: &Bodies, domain: &Domain, skin: f64) -> Vec<(u32, u32, [i16; 2])> {
+        let mut expected = Vec::new();
+        for i in 0..b.len() {
+            for j in i + 1..b.len() {
+                let reach = b.bounding_radius[i] + b.bounding_radius[j] + skin;
+                for image in [-1i16, 0, 1].iter().flat_map(|&x| [-1i16, 0, 1].map(|y| [x, y])) {
+                    let shift = if domain.is_periodic() { domain.shift(image) } else { Vector3::zeros() };
+                    if (domain.is_periodic() || image == [0, 0])
+                        && (b.position[j] + shift - b.position[i]).norm() < reach
+                    {
+                        expected.push((i as u32, j as u32, image));
+                    }
+                }
+            }
+        }
+        expected.sort();
+        expected
+    }
+
+    #[test]
+    fn grains_of_widely_different_sizes_get_every_pair_within_reach_once() {
+        // Spheres of 0.5 to 8 mm radius (the range of Table 3's U7 and B50 sieves), the largest
+        // reaching across the whole 5 cm box, where the search wraps around every cell once.
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let skin = 2e-4;
+        for domain in [Domain::Periodic { width: 0.05 }, Domain::Cylinder { diameter: 0.05 }] {
+            let mut b = Bodies::default();
+            for _ in 0..600 {
+                let radius = 5e-4 * 16f64.powf(rng.random::<f64>().powi(3));
+                let (x, y) = (rng.random::<f64>() * 0.05, rng.random::<f64>() * 0.05);
+                let body = NewBody {
+                    shape: Shape::Sphere { radius },
+                    position: Vector3::new(x, y, rng.random::<f64>() * 0.03),
+                    orientation: UnitQuaternion::identity(),
+                    velocity: Vector3::zeros(),
+                    angular_velocity: Vector3::zeros(),
+                };
+                b.push(body, 2650.0);
+            }
+            let mut list = NeighbourList::new(skin);
+            list.rebuild(&mut b, &domain, &mut BuildScratch::default()).unwrap();
+            let listed: Vec<(u32, u32, [i16; 2])> = list.pairs.iter().map(|p| (p.i, p.j, p.image)).collect();
+            let expected = all_pairs_within_reach(&b, &domain, skin);
+            assert!(expected.len() > 500, "{domain:?}: {} pairs", expected.len());
+            assert_eq!(listed, expected, "{domain:?}");
+        }
     }
 
     #[test]
