@@ -452,5 +452,8 @@ fn the_imbrication_of_each_setup_is_summed_over_its_runs() {
         ),
         "{md}"
     );
+    // No run deposited with buoyancy only: nothing to pair the porosities with.
+    assert!(md.contains("| all jobs | drag and lift, still water | 2 | 0.3700 | 0.0000 |\n"), "{md}");
+    assert!(!md.contains("minus buoyancy only"), "{md}");
     check_html(out.path(), 0);
 }

@@ -516,32 +516,32 @@ fn fluid_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
     let seeded = |runs: &[&JobRecord]| -> Vec<SeededRun> {
         runs.iter().map(|r| (r.parameters.get("seed").map(value_text), r.porosity)).collect()
     };
+    // Runs deposited with buoyancy only are what the fluid's runs are paired with, if any.
+    let paired = groups.iter().any(|g| g.1 == DRY);
     let rows = groups
         .iter()
         .map(|(setup, fluid, runs)| {
             let porosities: Vec<f64> = runs.iter().map(|r| r.porosity).collect();
             let (mean, std) = mean_std(&porosities);
-            let dry = groups.iter().find(|g| g.0 == *setup && g.1 == DRY).filter(|_| fluid != DRY);
-            let paired = dry.map_or("—".to_string(), |dry| paired_difference(&seeded(runs), &seeded(&dry.2)));
-            vec![
-                setup.clone(),
-                fluid.clone(),
-                runs.len().to_string(),
-                format!("{mean:.4}"),
-                format!("{std:.4}"),
-                paired,
-            ]
+            let mut row =
+                vec![setup.clone(), fluid.clone(), runs.len().to_string(), format!("{mean:.4}"), format!("{std:.4}")];
+            if paired {
+                let dry = groups.iter().find(|g| g.0 == *setup && g.1 == DRY).filter(|_| fluid != DRY);
+                row.push(dry.map_or("—".to_string(), |dry| paired_difference(&seeded(runs), &seeded(&dry.2))));
+            }
+            row
         })
         .collect();
-    blocks.push(Block::Table {
-        header: ["setup", "fluid", "runs", "porosity n (mean)", "std", "minus buoyancy only, same seeds"]
-            .map(String::from)
-            .to_vec(),
-        rows,
-    });
-    blocks.push(Block::Paragraph(
-        "The last column pairs each run with the run of the same seed deposited with buoyancy only: the mean of their differences ± its standard error (the sample standard deviation of the differences over √pairs), and the number of pairs. Pairing takes out what the seed alone decides, so a small effect shows sooner than in the two means.".into(),
-    ));
+    let mut header: Vec<String> = ["setup", "fluid", "runs", "porosity n (mean)", "std"].map(String::from).to_vec();
+    if paired {
+        header.push("minus buoyancy only, same seeds".into());
+    }
+    blocks.push(Block::Table { header, rows });
+    if paired {
+        blocks.push(Block::Paragraph(
+            "The last column pairs each run with the run of the same seed deposited with buoyancy only: the mean of their differences ± its standard error (the sample standard deviation of the differences over √pairs), and the number of pairs. Pairing takes out what the seed alone decides, so a small effect shows sooner than in the two means.".into(),
+        ));
+    }
 
     let imbricated: Vec<(&JobRecord, String)> =
         records.iter().zip(short_ids(records)).filter(|(r, _)| r.imbrication.is_some()).collect();
