@@ -65,6 +65,19 @@ impl Domain {
         }
     }
 
+    /// Squared distance from i to the nearest periodic image of j, both inside the box: each
+    /// component of their separation is then within ±L, so at most one period is added or taken.
+    #[inline]
+    pub fn nearest_distance2(&self, xi: &Vector3<f64>, xj: &Vector3<f64>) -> f64 {
+        let d = xj - xi;
+        let nearest = |d: f64| match *self {
+            Domain::Periodic { width } if d > 0.5 * width => d - width,
+            Domain::Periodic { width } if d < -0.5 * width => d + width,
+            _ => d,
+        };
+        nearest(d.x).powi(2) + nearest(d.y).powi(2) + d.z * d.z
+    }
+
     /// Every periodic image of j within `reach` of i along both periodic axes: the nearest one,
     /// and its neighbour too when `reach` exceeds half the period (long grains in a narrow box).
     pub fn images_within(&self, xi: &Vector3<f64>, xj: &Vector3<f64>, reach: f64) -> impl Iterator<Item = [i16; 2]> {

@@ -276,14 +276,6 @@ impl NeighbourList {
     fn list_pairs(&mut self, bodies: &Bodies, domain: &Domain, grid: &Grid, s: &BuildScratch) {
         self.pairs.clear();
         let radius = &bodies.bounding_radius;
-        let (l, periodic) = (domain.width(), domain.is_periodic());
-        // Positions are in the box, so a component of a separation is within ±l and the nearest
-        // image is at most one period away; beyond reach there, it is beyond reach everywhere.
-        let nearest = |d: f64| match periodic {
-            true if d > 0.5 * l => d - l,
-            true if d < -0.5 * l => d + l,
-            _ => d,
-        };
         for (i, (&xi, &ri)) in bodies.position.iter().zip(radius).enumerate() {
             let ci = grid.coordinates(&xi);
             let search = 2.0 * ri + self.skin;
@@ -296,9 +288,10 @@ impl NeighbourList {
                             if m.radius > ri || (m.radius == ri && other <= i) {
                                 continue;
                             }
-                            let d = m.position - xi;
+                            // Positions are wrapped into the box; beyond reach of the nearest
+                            // image, every image is.
                             let reach = ri + m.radius + self.skin;
-                            if nearest(d.x).powi(2) + nearest(d.y).powi(2) + d.z * d.z < reach * reach {
+                            if domain.nearest_distance2(&xi, &m.position) < reach * reach {
                                 self.list_pair(bodies, domain, i.min(other), i.max(other));
                             }
                         }
