@@ -48,9 +48,11 @@ pub struct NeighbourList {
     /// Whole periods each body has been moved back into the box by since the start; a pair's
     /// image corrected by them identifies the same contact across rebuilds.
     wraps: Vec<[i32; 2]>,
-    /// Per body b, `as_j[first_as_j[b]..first_as_j[b + 1]]` are the pairs where it is j (those
-    /// where it is i are contiguous in `pairs`). Derived from `pairs`, so not kept in the state:
-    /// [`NeighbourList::index`] builds it anew after a restore.
+    /// Per body b, `as_j[first_as_j[b]..first_as_j[b + 1]]` are the pairs where it is j, and
+    /// `pairs[first_as_i[b]..first_as_i[b + 1]]` those where it is i. Derived from `pairs`, so
+    /// not kept in the state: [`NeighbourList::index`] builds them anew after a restore.
+    #[serde(skip)]
+    pub first_as_i: Vec<u32>,
     #[serde(skip)]
     first_as_j: Vec<u32>,
     #[serde(skip)]
@@ -150,6 +152,7 @@ impl NeighbourList {
             reference: Vec::new(),
             reference_orientation: Vec::new(),
             wraps: Vec::new(),
+            first_as_i: vec![0],
             first_as_j: vec![0],
             as_j: Vec::new(),
             builds: 0,
@@ -184,6 +187,7 @@ impl NeighbourList {
         size_of_val(&self.reference[..])
             + size_of_val(&self.reference_orientation[..])
             + size_of_val(&self.wraps[..])
+            + size_of_val(&self.first_as_i[..])
             + size_of_val(&self.first_as_j[..])
     }
 
@@ -202,7 +206,7 @@ impl NeighbourList {
         &self.as_j[self.first_as_j[b] as usize..self.first_as_j[b + 1] as usize]
     }
 
-    /// Builds the index of pairs by body j for `n` bodies if it is missing (a restored list).
+    /// Builds the indices of pairs by body for `n` bodies if they are missing (a restored list).
     pub fn index(&mut self, n: usize, scratch: &mut BuildScratch) {
         if self.first_as_j.len() != n + 1 {
             self.index_by_body(n, &mut scratch.fill);
@@ -342,14 +346,19 @@ impl NeighbourList {
         }
     }
 
-    /// Lists each body's pairs as body j, by a counting sort on j.
+    /// Lists where each body's pairs as body i begin, and its pairs as body j by a counting
+    /// sort on j.
     fn index_by_body(&mut self, n: usize, cursor: &mut Vec<u32>) {
+        self.first_as_i.clear();
+        self.first_as_i.resize(n + 1, 0);
         self.first_as_j.clear();
         self.first_as_j.resize(n + 1, 0);
         for p in &self.pairs {
+            self.first_as_i[p.i as usize + 1] += 1;
             self.first_as_j[p.j as usize + 1] += 1;
         }
         for b in 0..n {
+            self.first_as_i[b + 1] += self.first_as_i[b];
             self.first_as_j[b + 1] += self.first_as_j[b];
         }
         self.as_j.clear();
