@@ -349,7 +349,7 @@ fn a_campaign_over_grain_shapes_compares_them_at_equal_form() {
         "{md}"
     );
     assert!(
-        md.contains(r#"| grains.form = {"fl":0.5,"el":0.5} | 4.00 | 0.400 ± 0.000 (1) | 0.407 ± 0.002 (3) | +0.007 |"#),
+        md.contains(r#"| grains.form = {"fl":0.5,"el":0.5} | 4.00 | 0.400 (1) | 0.407 ± 0.002 (3) | +0.007 |"#),
         "{md}"
     );
     assert!(md.contains("RMS difference `mesh` − `ellipsoid` over 2 setups: 0.0092."), "{md}");

@@ -388,7 +388,7 @@ fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), R
     }
     blocks.push(Block::Heading("Grain shape at equal form (Fig. 10)".into()));
     blocks.push(Block::Paragraph(format!(
-        "Each setup's packings per grain shape: the mean inverse equancy L/S of their grains, and their porosity (mean ± population std over the seeds, runs in brackets). The differences are to the first shape, `{}`; RMS over the setups where both have runs (the paper finds ~0.008 between meshes and their equivalent ellipsoids).",
+        "Each setup's packings per grain shape: the mean inverse equancy L/S of their grains, and their porosity (mean ± population std over the seeds, runs in brackets; a single run shows its value alone). The differences are to the first shape, `{}`; RMS over the setups where both have runs (the paper finds ~0.008 between meshes and their equivalent ellipsoids).",
         shapes[0]
     )));
     let cell = |runs: &[(f64, f64)]| {
@@ -396,7 +396,11 @@ fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), R
             return "–".to_string();
         }
         let (mean, std) = mean_std(&runs.iter().map(|r| r.1).collect::<Vec<_>>());
-        format!("{mean:.3} ± {std:.3} ({})", runs.len())
+        // One run has no spread to show.
+        match runs.len() {
+            1 => format!("{mean:.3} (1)"),
+            n => format!("{mean:.3} ± {std:.3} ({n})"),
+        }
     };
     let mut squares = vec![Vec::new(); shapes.len()];
     let rows = setups
