@@ -210,8 +210,8 @@ pub fn series_with_spread(title: &str, x_label: &str, y_label: &str, series: &[S
         let all = || series.iter().flat_map(|s| s.points.iter());
         let x = padded_range(all().map(|p| p.0));
         let y = padded_range(all().flat_map(|p| [p.1 - p.2, p.1 + p.2]));
-        // Headroom for the legend (upper left, ~6 % of the height per line) so that it hides no
-        // point.
+        // Headroom for the legend (upper left: its frame and one line per series) so that it
+        // hides no point.
         let y = (y.0, y.1 + (y.1 - y.0) * (0.08 + 0.07 * series.len() as f64));
         let mut chart = chart(root, title, 19, x, y)?;
         axes(&mut chart, x_label, y_label, x, y)?;

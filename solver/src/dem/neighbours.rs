@@ -52,7 +52,7 @@ pub struct NeighbourList {
     /// `pairs[first_as_i[b]..first_as_i[b + 1]]` those where it is i. Derived from `pairs`, so
     /// not kept in the state: [`NeighbourList::index`] builds them anew after a restore.
     #[serde(skip)]
-    pub first_as_i: Vec<u32>,
+    pub(crate) first_as_i: Vec<u32>,
     #[serde(skip)]
     first_as_j: Vec<u32>,
     #[serde(skip)]

@@ -75,6 +75,8 @@ struct Load {
 /// What the pair stage reads: the bodies, their poses of this step, the contact law.
 struct PairStage<'a> {
     bodies: &'a Bodies,
+    /// Where each body's pairs as body i begin in the pair list.
+    starts: &'a [u32],
     domain: Domain,
     poses: &'a [Pose],
     law: &'a LinearSpringDashpot,
@@ -82,14 +84,12 @@ struct PairStage<'a> {
 }
 
 impl PairStage<'_> {
-    /// The pairs of bodies `first..first + loads.len()` as body i (listed by i, body b's from
-    /// `starts[b]` on), halved at a body until a task holds few pairs; the halves are the same
-    /// whatever the threads, so every sum is too.
-    #[allow(clippy::too_many_arguments)]
+    /// The pairs of bodies `first..first + loads.len()` as body i (listed by i), halved at a
+    /// body until a task holds few pairs; the halves are the same whatever the threads, so
+    /// every sum is too.
     fn run(
         &self,
         first: usize,
-        starts: &[u32],
         pairs: &[Pair],
         history: &mut [ContactHistory],
         cache: &mut [PairCache],
@@ -99,15 +99,15 @@ impl PairStage<'_> {
         if pairs.len() > PAIRS_PER_TASK && loads.len() > 1 {
             let half = loads.len() / 2;
             // An index, not a search of the pairs: the search's probes missed the cache.
-            let cut = (starts[first + half] - starts[first]) as usize;
+            let cut = (self.starts[first + half] - self.starts[first]) as usize;
             let (pairs_a, pairs_b) = pairs.split_at(cut);
             let (history_a, history_b) = history.split_at_mut(cut);
             let (cache_a, cache_b) = cache.split_at_mut(cut);
             let (out_a, out_b) = out.split_at_mut(cut);
             let (loads_a, loads_b) = loads.split_at_mut(half);
             let (a, b) = rayon::join(
-                || self.run(first, starts, pairs_a, history_a, cache_a, out_a, loads_a),
-                || self.run(first + half, starts, pairs_b, history_b, cache_b, out_b, loads_b),
+                || self.run(first, pairs_a, history_a, cache_a, out_a, loads_a),
+                || self.run(first + half, pairs_b, history_b, cache_b, out_b, loads_b),
             );
             return (a.0 + b.0, a.1.max(b.1));
         }
@@ -453,10 +453,16 @@ impl Simulation {
         pair_forces.resize(self.neighbours.pairs.len(), PairForce::default());
         loads.clear();
         loads.resize(self.bodies.len(), Load::default());
-        let stage =
-            PairStage { bodies: &self.bodies, domain: self.domain, poses, law: &self.law, dt: self.settings.time_step };
         let list = &mut self.neighbours;
-        stage.run(0, &list.first_as_i, &list.pairs, &mut list.history, &mut list.cache, pair_forces, loads)
+        let stage = PairStage {
+            bodies: &self.bodies,
+            starts: &list.first_as_i,
+            domain: self.domain,
+            poses,
+            law: &self.law,
+            dt: self.settings.time_step,
+        };
+        stage.run(0, &list.pairs, &mut list.history, &mut list.cache, pair_forces, loads)
     }
 
     /// Per body: wall contacts, the sum of its pair forces, external forces, then the
