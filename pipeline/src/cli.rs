@@ -351,7 +351,7 @@ impl OptionalDistributionArgs {
 }
 
 #[derive(Debug, Args)]
-#[command(group(ArgGroup::new("input").required(true).args(["lis", "mesh", "mu_fl", "bonded"])))]
+#[command(group(ArgGroup::new("input").required(true).args(["lis", "mesh", "library", "mu_fl", "bonded"])))]
 pub struct FormsArgs {
     /// Long, intermediate and short axes (L ≥ I ≥ S > 0, any length unit).
     #[arg(long, num_args = 3, value_names = ["L", "I", "S"], allow_negative_numbers = true)]
@@ -359,9 +359,15 @@ pub struct FormsArgs {
     /// A closed triangle mesh (STL or OBJ); its form is that of its mass-equivalent ellipsoid.
     #[arg(long)]
     pub mesh: Option<PathBuf>,
-    /// Simplify the mesh to at most this many faces first (quadric edge collapse, §5.2.1) and
-    /// report the relative volume change.
-    #[arg(long, requires = "mesh")]
+    /// A mesh library as job files name it (builtin:rhine, builtin:pebbles or a folder of STL/OBJ
+    /// files): each mesh's own form and angularity (its sphericity over that of the ellipsoid of
+    /// its form), with their means, beside the Rhine form distribution of Table 2.
+    #[arg(long)]
+    pub library: Option<String>,
+    /// Simplify the mesh (or the library's meshes) to at most this many faces first (quadric
+    /// edge collapse, §5.2.1) and report the relative volume change; a library defaults to 300,
+    /// as in packings.
+    #[arg(long)]
     pub faces: Option<usize>,
     /// The bonded-sphere grain of Sun & Xiao built for axes L ≥ I ≥ S: its Zingg class, component
     /// spheres and mass properties beside those of the ellipsoid with the same axes.

@@ -24,30 +24,47 @@ pub fn is_builtin(source: &str) -> bool {
 /// Loads and prepares a library. A folder is given relative to `base` (the job file's folder)
 /// and stored as an absolute path.
 pub fn load(source: &str, faces: usize, base: &Path) -> anyhow::Result<MeshLibrary> {
-    let source = match source {
+    let source = resolve(source, base)?;
+    let meshes: Vec<UnitMesh> = prepare(&source, faces)?.into_iter().map(|(_, mesh)| mesh).collect();
+    Ok(MeshLibrary { digest: digest(&meshes), source, faces, meshes })
+}
+
+/// A library's source as it is stored: a builtin name, or a folder (relative to `base`) as an
+/// absolute path.
+pub fn resolve(source: &str, base: &Path) -> anyhow::Result<String> {
+    Ok(match source {
         RHINE | PEBBLES => source.to_string(),
         folder => {
             let path = base.join(folder);
             let path = path.canonicalize().with_context(|| format!("{}", path.display()))?;
             path.display().to_string()
         }
-    };
-    let meshes = prepare(&source, faces)?;
-    Ok(MeshLibrary { digest: digest(&meshes), source, faces, meshes })
+    })
 }
 
 /// Fills in the meshes of a library read back from the store and checks they are the same.
 pub fn reload(library: &mut MeshLibrary) -> anyhow::Result<()> {
-    let meshes = prepare(&library.source, library.faces)
-        .with_context(|| format!("grains.meshes: the meshes of {} cannot be read", library.source))?;
+    let meshes: Vec<UnitMesh> = prepare(&library.source, library.faces)
+        .with_context(|| format!("grains.meshes: the meshes of {} cannot be read", library.source))?
+        .into_iter()
+        .map(|(_, mesh)| mesh)
+        .collect();
     if digest(&meshes) != library.digest {
+        if is_builtin(&library.source) {
+            return Err(anyhow!(
+                "{}: this sedpack's built-in meshes differ from those the job was submitted with; finish it with the sedpack that submitted it",
+                library.source
+            ));
+        }
         return Err(anyhow!("{}: the meshes changed since the job was submitted", library.source));
     }
     library.meshes = meshes;
     Ok(())
 }
 
-fn prepare(source: &str, faces: usize) -> anyhow::Result<Vec<UnitMesh>> {
+/// The meshes of a library (its source as [`load`] stores it), made convex, simplified and
+/// normalised, with their names.
+pub fn prepare(source: &str, faces: usize) -> anyhow::Result<Vec<(String, UnitMesh)>> {
     let named: Vec<(String, TriMesh)> = match source {
         RHINE => rhine_meshes(),
         PEBBLES => pebble_library(PEBBLE_COUNT, 1, faces.min(DEFAULT_MAX_FACES))
@@ -72,7 +89,8 @@ fn prepare(source: &str, faces: usize) -> anyhow::Result<Vec<UnitMesh>> {
                 TriMesh::convex_hull(mesh.vertices()).map_err(|e| anyhow!("{name}: convex hull {e}"))?
             };
             let simplified = simplify(&convex, faces).with_context(|| name.clone())?;
-            UnitMesh::new(&simplified.mesh).with_context(|| name.clone())
+            let unit = UnitMesh::new(&simplified.mesh).with_context(|| name.clone())?;
+            Ok((name, unit))
         })
         .collect()
 }
@@ -97,4 +115,33 @@ fn digest(meshes: &[UnitMesh]) -> String {
         }
     }
     hash.finalize().iter().take(16).map(|b| format!("{b:02x}")).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_stored_library_whose_meshes_changed_is_refused_with_what_to_do() {
+        let mut stored = load(RHINE, 100, Path::new(".")).unwrap();
+        reload(&mut stored).unwrap();
+        // A digest from another version of the built-in meshes (the pebbles of 0.1.0).
+        stored.digest = "11f3cc3136ba87d4f2dd5e5e84891773".into();
+        let error = format!("{:#}", reload(&mut stored).unwrap_err());
+        assert!(error.contains("builtin:rhine") && error.contains("the sedpack that submitted it"), "{error}");
+        let folder = tempfile::tempdir().unwrap();
+        let (_, scan) = &rhine_meshes()[1];
+        let obj: String = scan.vertices().iter().map(|v| format!("v {} {} {}\n", v.x, v.y, v.z)).collect::<String>()
+            + &scan
+                .triangles()
+                .iter()
+                .map(|t| format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1))
+                .collect::<String>();
+        std::fs::write(folder.path().join("grain.obj"), &obj).unwrap();
+        let mut stored = load(folder.path().to_str().unwrap(), 100, Path::new(".")).unwrap();
+        // A second file in the folder since.
+        std::fs::write(folder.path().join("other.obj"), &obj).unwrap();
+        let error = format!("{:#}", reload(&mut stored).unwrap_err());
+        assert!(error.contains("the meshes changed since the job was submitted"), "{error}");
+    }
 }

@@ -49,6 +49,43 @@ fn forms_mesh_gives_the_box_axes() {
 }
 
 #[test]
+fn forms_library_gives_each_meshs_form_and_angularity_and_their_means() {
+    // A folder with a 3 × 2 × 1 box and a unit cube, worked by hand: the box has FL = S/I = 1/2,
+    // EL = I/L = 2/3 (its equivalent ellipsoid's axes are the box's times sqrt(5/3)); Wadell's
+    // sphericity is π^(1/3) (6V)^(2/3) / A: V = 6, A = 22 for the box, V = 1, A = 6 for the cube,
+    // whose equivalent ellipsoid is a sphere (sphericity 1), so its relative sphericity is its
+    // own.
+    let dir = tempfile::tempdir().unwrap();
+    let write_box = |name: &str, a: [f64; 3]| {
+        let mut obj = String::new();
+        for k in 0..8 {
+            let s = |bit: usize| if k & (1 << bit) != 0 { a[bit] / 2.0 } else { -a[bit] / 2.0 };
+            obj.push_str(&format!("v {} {} {}\n", s(0), s(1), s(2)));
+        }
+        obj.push_str("f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n");
+        std::fs::write(dir.path().join(name), obj).unwrap();
+    };
+    write_box("box.obj", [3.0, 2.0, 1.0]);
+    write_box("cube.obj", [1.0, 1.0, 1.0]);
+    let v = json(&["forms", "--library", dir.path().to_str().unwrap(), "--json"]);
+    let wadell = |volume: f64, area: f64| std::f64::consts::PI.cbrt() * (6.0 * volume).powf(2.0 / 3.0) / area;
+    let meshes = v["meshes"].as_array().unwrap();
+    assert_eq!(meshes.len(), 2);
+    let (boxed, cube) = (&meshes[0], &meshes[1]);
+    assert_eq!(boxed["mesh"], "box.obj");
+    assert_eq!(cube["triangles"], 12);
+    let close = |x: &serde_json::Value, want: f64| (x.as_f64().unwrap() - want).abs() < 1e-9;
+    assert!(close(&boxed["FL"], 0.5) && close(&boxed["EL"], 2.0 / 3.0));
+    assert!(close(&boxed["sphericity"], wadell(6.0, 22.0)));
+    assert!(close(&cube["sphericity"], wadell(1.0, 6.0)) && close(&cube["relative_sphericity"], wadell(1.0, 6.0)));
+    assert!(close(&v["summary"]["sphericity"]["mean"], 0.5 * (wadell(6.0, 22.0) + wadell(1.0, 6.0))));
+    assert!(close(&v["summary"]["FL"]["mean"], 0.75) && close(&v["summary"]["FL"]["std"], 0.5f64.sqrt() * 0.5));
+    assert!(close(&v["table2"]["mu_FL"], 0.647));
+    fails(&["forms", "--library", "no-such-folder"], &["--library no-such-folder", "folder of meshes"]);
+    fails(&["forms", "--lis", "3", "2", "1", "--faces", "100"], &["--faces", "--mesh or a --library"]);
+}
+
+#[test]
 fn forms_bonded_builds_the_rod_of_three_spheres() {
     // L = 3, I = S = 1 is a rod (I/L < 2/3, S/I > 2/3): a row of spheres of diameter
     // sqrt(S·I) = 1 spanning L, i.e. three touching unit spheres centred at −1, 0, 1 (§2.4);

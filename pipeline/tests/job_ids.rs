@@ -1,6 +1,8 @@
 //! Job ids are hashes of the stored job: the same campaign file must give the same ids and the
 //! same stored JSON as sedpack 0.1.0 gave (tests/fixtures/job-ids/ids-0.1.0.json), or resubmitted
-//! campaigns would run every job again.
+//! campaigns would run every job again. The one exception is meant: `builtin:pebbles` were made
+//! as angular as the Rhine scans since, so their digest, and with it the id of every job drawing
+//! from them, changed (a resubmitted campaign runs those again, with the new pebbles).
 
 mod common;
 
@@ -22,11 +24,19 @@ fn campaign_files_give_the_job_ids_of_version_0_1_0() {
         let jobs = jobs.as_array().unwrap();
         assert_eq!(campaign.jobs.len(), jobs.len(), "{file}");
         for (job, want) in campaign.jobs.iter().zip(jobs) {
+            let mut changed = false;
             if let Some(spec) = want.get("spec") {
-                let stored: Value = serde_json::from_str(&sedpack::stored::canonical_json(&job.spec)).unwrap();
+                let mut stored: Value = serde_json::from_str(&sedpack::stored::canonical_json(&job.spec)).unwrap();
+                let meshes = &mut stored["packing"]["grains"]["meshes"];
+                if meshes["source"] == "builtin:pebbles" {
+                    let digest = &spec["packing"]["grains"]["meshes"]["digest"];
+                    assert_ne!(&meshes["digest"], digest, "{file}: the pebbles of 0.1.0");
+                    meshes["digest"] = digest.clone();
+                    changed = true;
+                }
                 assert_eq!(&stored, spec, "{file}: the stored job");
             }
-            assert_eq!(job.id, want["id"].as_str().unwrap(), "{file}");
+            assert_eq!(job.id == want["id"].as_str().unwrap(), !changed, "{file}");
         }
     }
     // The validation campaign's grid was reordered since (seeds outermost): the same jobs, in another order.

@@ -1,15 +1,25 @@
 //! `sedpack forms`: the form of one grain (--lis, --mesh) or of a form distribution.
 
-use anyhow::Context;
+use anyhow::{Context, bail};
 use serde_json::{Map, Value, json};
-use solver::grain::simplify::simplify;
-use solver::grain::{EquivalentEllipsoid, FormDistribution, FormParameters, TriMesh, bonded_grain, ellipsoid_mass};
+use solver::grain::simplify::{DEFAULT_MAX_FACES, simplify};
+use solver::grain::{
+    Angularity, EquivalentEllipsoid, FormDistribution, FormParameters, RHINE_FORMS, TriMesh, bonded_grain,
+    ellipsoid_mass,
+};
 
 use crate::cli::{DistributionArgs, FormsArgs};
+use crate::meshes;
 use crate::outln;
 use crate::output::{Table, number, print_json};
 
 pub fn run(args: &FormsArgs) -> anyhow::Result<()> {
+    if args.faces.is_some() && args.mesh.is_none() && args.library.is_none() {
+        bail!("--faces: simplifies a --mesh or a --library; there is none to simplify");
+    }
+    if let Some(source) = &args.library {
+        return library(source, args.faces.unwrap_or(DEFAULT_MAX_FACES), args.json);
+    }
     let (record, title) = if let Some(lis) = &args.lis {
         let form = FormParameters::new(lis[0], lis[1], lis[2]).context("--lis")?;
         (grain_record(&form, form.ellipsoid_volume()), "grain (ellipsoid with full axes L, I, S)".to_string())
@@ -149,4 +159,117 @@ fn distribution_record(d: &DistributionArgs) -> anyhow::Result<Map<String, Value
     // What the grains will actually have after redrawing outside [0.1, 1].
     record.insert("truncated".into(), serde_json::to_value(dist.truncated_moments())?);
     Ok(record)
+}
+
+/// One row per mesh of a library (own form, sphericities, angularity) and their means and
+/// standard deviations beside the Rhine form distribution of Table 2, which the paper's 63 scans
+/// follow: what a packing poured from the library's own forms draws from.
+fn library(source: &str, faces: usize, json: bool) -> anyhow::Result<()> {
+    let source = meshes::resolve(source, &std::env::current_dir()?).with_context(|| {
+        format!("--library {source}: expected builtin:rhine, builtin:pebbles or a folder of meshes")
+    })?;
+    let mut rows = Vec::new();
+    for (path, unit) in meshes::prepare(&source, faces).with_context(|| format!("--library {source}"))? {
+        // A folder's meshes are named by their file names: the folder heads the table.
+        let name = std::path::Path::new(&path).file_name().map_or(path.clone(), |n| n.to_string_lossy().into_owned());
+        let mesh = unit.rescaled(&unit.original_form());
+        let a = Angularity::of(&mesh).with_context(|| format!("{source}: {name}"))?;
+        rows.push(json!({
+            "mesh": name,
+            "triangles": mesh.triangles().len(),
+            "FL": a.form.s / a.form.i,
+            "EL": a.form.i / a.form.l,
+            "sphericity": a.sphericity,
+            "ellipsoid_sphericity": a.ellipsoid_sphericity,
+            "relative_sphericity": a.relative_sphericity(),
+            "volume_ratio": a.volume_ratio,
+        }));
+    }
+    let column = |key: &str| rows.iter().map(|r| r[key].as_f64().unwrap_or(f64::NAN)).collect::<Vec<_>>();
+    let mut summary = Map::new();
+    for key in ["FL", "EL", "sphericity", "relative_sphericity", "volume_ratio"] {
+        let (mean, std) = mean_std(&column(key));
+        summary.insert(key.into(), json!({"mean": mean, "std": std}));
+    }
+    let table2 = RHINE_FORMS;
+    let record = json!({
+        "library": source,
+        "faces": faces,
+        "meshes": rows,
+        "summary": summary,
+        "table2": {"mu_FL": table2.mu_fl, "sigma_FL": table2.sigma_fl, "mu_EL": table2.mu_el, "sigma_EL": table2.sigma_el},
+    });
+    if json {
+        return print_json(&record);
+    }
+    outln!("library {source} (at most {faces} faces)")?;
+    outln!(
+        "{:<24} {:>9} {:>6} {:>6} {:>10} {:>10} {:>9} {:>8}",
+        "mesh",
+        "triangles",
+        "FL",
+        "EL",
+        "sphericity",
+        "ellipsoid",
+        "relative",
+        "volume"
+    )?;
+    for r in &rows {
+        let f = |key: &str| r[key].as_f64().unwrap_or(f64::NAN);
+        outln!(
+            "{:<24} {:>9} {:>6.3} {:>6.3} {:>10.3} {:>10.3} {:>9.3} {:>8.3}",
+            r["mesh"].as_str().unwrap_or_default(),
+            r["triangles"].as_u64().unwrap_or_default(),
+            f("FL"),
+            f("EL"),
+            f("sphericity"),
+            f("ellipsoid_sphericity"),
+            f("relative_sphericity"),
+            f("volume_ratio")
+        )?;
+    }
+    let s = |key: &str, stat: &str| summary[key][stat].as_f64().unwrap_or(f64::NAN);
+    outln!(
+        "{:<24} {:>9} {:>6.3} {:>6.3} {:>10.3} {:>10} {:>9.3} {:>8.3}",
+        "mean",
+        "",
+        s("FL", "mean"),
+        s("EL", "mean"),
+        s("sphericity", "mean"),
+        "",
+        s("relative_sphericity", "mean"),
+        s("volume_ratio", "mean")
+    )?;
+    outln!(
+        "{:<24} {:>9} {:>6.3} {:>6.3} {:>10.3} {:>10} {:>9.3} {:>8.3}",
+        "standard deviation",
+        "",
+        s("FL", "std"),
+        s("EL", "std"),
+        s("sphericity", "std"),
+        "",
+        s("relative_sphericity", "std"),
+        s("volume_ratio", "std")
+    )?;
+    outln!(
+        "{:<24} {:>9} {:>6.3} {:>6.3}   (standard deviations {:.3}, {:.3}: the 63 scans of the paper)",
+        "Table 2 (Rhine)",
+        "",
+        table2.mu_fl,
+        table2.mu_el,
+        table2.sigma_fl,
+        table2.sigma_el
+    )?;
+    outln!(
+        "sphericity: Wadell's, of the mesh and of its mass-equivalent ellipsoid (Appendix A); relative: their ratio, 1 for an ellipsoid and lower the more angular the grain at its form; volume: the mesh's over that ellipsoid's"
+    )?;
+    Ok(())
+}
+
+/// Mean and sample standard deviation (0 for a single value).
+fn mean_std(values: &[f64]) -> (f64, f64) {
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let var = if values.len() > 1 { values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0) } else { 0.0 };
+    (mean, var.sqrt())
 }

@@ -4,6 +4,7 @@
 //! generated pebble meshes and the bonded-sphere grains of the second paper (its §2.4 and
 //! Appendix).
 
+pub mod angularity;
 pub mod bonded;
 pub mod ellipsoid;
 pub mod form;
@@ -15,6 +16,7 @@ pub mod simplify;
 pub mod size;
 pub mod unit_mesh;
 
+pub use angularity::Angularity;
 pub use bonded::{
     BondedGrain, ComponentSphere, EQUANT_EPSILON, SolidMass, ZinggClass, bonded_grain, construction, ellipsoid_mass,
     sphere_mass_properties,

@@ -1,6 +1,7 @@
 //! Seeded convex "pebble" meshes for users without grain scans: the convex hull of a point
-//! cloud on a lumpy ellipsoid, chipped by a few random planes so that the grain has the flat
-//! facets and edges of fluvial gravel rather than the smoothness of an ellipsoid.
+//! cloud on a lumpy ellipsoid, chipped by random planes so that the grain has the flat facets
+//! and edges of fluvial gravel rather than the smoothness of an ellipsoid, as angular at its
+//! form as the shipped Rhine scans.
 
 use nalgebra::Vector3;
 use rand::{RngExt, SeedableRng};
@@ -23,8 +24,12 @@ pub fn pebble(seed: u64, max_faces: usize) -> Result<TriMesh, MeshDefect> {
     let lumps: Vec<(Vector3<f64>, f64)> =
         (0..6).map(|_| (random_direction(&mut rng), rng.random_range(-0.12..0.12))).collect();
     // Chips: planes that cut off caps, leaving flat facets; offsets as fractions of the support.
+    // This many, this deep, make pebbles as angular as the Rhine scans (their sphericity over
+    // that of the ellipsoid of their form, `Angularity`: 0.944 ± 0.008 for the 20 of
+    // builtin:pebbles against 0.938 and 0.954 for the two scans; 4–8 chips at 0.72–0.92 gave
+    // 0.968 ± 0.005, grains rounder than the scans at the same form).
     let chips: Vec<(Vector3<f64>, f64)> =
-        (0..rng.random_range(4..9)).map(|_| (random_direction(&mut rng), rng.random_range(0.72..0.92))).collect();
+        (0..rng.random_range(8..14)).map(|_| (random_direction(&mut rng), rng.random_range(0.62..0.86))).collect();
 
     let cloud: Vec<Vector3<f64>> = (0..points)
         .map(|_| {
