@@ -157,7 +157,7 @@ fn clipped_cell(n: &V3, bodies: &[(&PolyhedronPose, V3, f64, f64)], kind: Overla
             cell.clip(&(n * -side), -side * level)?;
         }
         for (body, center, side, level) in bodies {
-            for_each_face_beyond(body, center, n, *side, *level, |normal, offset| cell.clip(&normal, offset))?;
+            for_each_face_beyond(body, center, n, *side, *level, |m, x| cell.clip_through(m, x))?;
         }
         cell.centroid().map(|c| (c, kind))
     })
@@ -329,24 +329,23 @@ impl Wedge {
     }
 }
 
-/// Calls `clip` with the outward unit normal and the plane offset (normal · x on the plane) of
-/// every face of `body` (centred at `center`) with a vertex beyond `level` on `side` along
-/// `axis`. `None` if there are more than the buffers hold, or if `clip` says so.
+/// Calls `clip` with an outward normal (of any length) and a corner of every face of `body`
+/// (centred at `center`) with a vertex beyond `level` on `side` along `axis`. `None` if there
+/// are more than the buffers hold, or if `clip` says so.
 fn for_each_face_beyond(
     body: &PolyhedronPose,
     center: &V3,
     axis: &V3,
     side: f64,
     level: f64,
-    mut clip: impl FnMut(V3, f64) -> Option<()>,
+    mut clip: impl FnMut(&V3, &V3) -> Option<()>,
 ) -> Option<()> {
     let shape = body.shape();
     // Heights along the axis in the body's own frame: one product per vertex met.
     let (local, base) = (body.local(&(axis * side)), side * (level - axis.dot(center)));
     let beyond = |v: u32| local.dot(&shape.vertices()[v as usize]) > base;
     triangles_beyond(body, &(axis * side), beyond, |t| {
-        let normal = body.normal(t);
-        clip(normal, normal.dot(&(center + body.vertex(shape.triangles()[t as usize][0]))))
+        clip(&body.normal_direction(t), &(center + body.vertex(shape.triangles()[t as usize][0])))
     })
 }
 
@@ -551,6 +550,19 @@ impl Cell {
         self.center = used.iter().sum::<V3>() / used.len().max(1) as f64;
         // One root for the largest distance (the root is monotonic, so the same value).
         self.radius = used.iter().map(|v| (v - self.center).norm_squared()).fold(0.0, f64::max).sqrt();
+    }
+
+    /// [`Cell::clip`] by the plane through `x` with outward normal `m` of any length. Most planes
+    /// miss the cell's ball, which is decided first from m·(x − centre) > r |m| squared, without
+    /// the root and division of a unit normal; a plane not clearly missing it (a relative margin
+    /// of 1e-9 on the squares) goes to `clip`, which decides as before, so the result is the same.
+    fn clip_through(&mut self, m: &V3, x: &V3) -> Option<()> {
+        let s = m.dot(&(x - self.origin - self.center));
+        if s > 0.0 && s * s > self.radius * self.radius * m.norm_squared() * (1.0 + 1e-9) {
+            return Some(());
+        }
+        let normal = m.normalize();
+        self.clip(&normal, normal.dot(x))
     }
 
     /// Keeps the part of the cell where normal · x ≤ offset (`normal` of unit length, x relative
@@ -1022,6 +1034,36 @@ mod tests {
             cell.face(&normal, &f.map(|k| v[k])).unwrap();
         }
         cell.bound();
+    }
+
+    #[test]
+    fn a_plane_given_by_any_normal_and_a_point_cuts_as_its_unit_normal_and_offset_do() {
+        // The unit cube's ball has centre (0.5, 0.5, 0.5) and radius √3/2 ≈ 0.866. Each plane
+        // through x with normal m (of length 3 or 0.2) must leave the cell exactly as `clip`
+        // with the unit normal and n·x does: planes missing the ball (decided without a unit
+        // normal), one grazing it, and planes through the cell.
+        let planes = [
+            (V3::new(3.0, 0.0, 0.0), V3::new(1.4, 0.0, 0.0)),
+            (V3::new(0.2, 0.2, 0.2), V3::new(1.0, 1.0, 1.0) * (0.5 + 0.5)),
+            (V3::new(0.0, 0.0, -3.0), V3::new(0.0, 0.0, 0.5 - 3f64.sqrt() / 2.0)),
+            (V3::new(3.0, 3.0, 0.0), V3::new(0.3, 0.3, 0.0)),
+            (V3::new(0.0, 0.2, 0.2), V3::new(0.0, 0.6, 0.6)),
+        ];
+        let state = |cell: &Cell| (cell.n_vertices, cell.n_faces, cell.centroid());
+        for (m, x) in planes {
+            let through = CELL.with_borrow_mut(|cell| {
+                cube(cell);
+                cell.clip_through(&m, &x).unwrap();
+                state(cell)
+            });
+            let unit = CELL.with_borrow_mut(|cell| {
+                cube(cell);
+                let n = m.normalize();
+                cell.clip(&n, n.dot(&x)).unwrap();
+                state(cell)
+            });
+            assert_eq!(through, unit, "plane {m} through {x}");
+        }
     }
 
     #[test]

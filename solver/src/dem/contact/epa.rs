@@ -65,15 +65,18 @@ pub(super) fn confirm<A: Convex, B: Convex>(
     if dist <= 0.0 {
         return None;
     }
-    // Each side face, oriented away from the base corner it misses, must lie farther out.
+    // Each side face, oriented away from the base corner it misses, must lie farther out:
+    // s·c > dist |s| for its normal s and centroid c, compared in squares (dist > 0), which
+    // spares each side a root and a division.
     for (p, q, other) in [(&p0, &p1, &p2), (&p1, &p2, &p0), (&p2, &p0, &p1)] {
         let side = (q.w - p.w).cross(&(apex.w - p.w));
-        let length = side.norm();
-        if length.is_nan() || length <= tiny * tiny {
+        let squared = side.norm_squared();
+        if squared.is_nan() || squared <= tiny.powi(4) {
             return None;
         }
-        let side = if side.dot(&(other.w - p.w)) > 0.0 { -side } else { side } / length;
-        if side.dot(&((p.w + q.w + apex.w) / 3.0)) <= dist {
+        let side = if side.dot(&(other.w - p.w)) > 0.0 { -side } else { side };
+        let out = side.dot(&((p.w + q.w + apex.w) / 3.0));
+        if out <= 0.0 || out * out <= dist * dist * squared {
             return None;
         }
     }

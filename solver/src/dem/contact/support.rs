@@ -105,7 +105,13 @@ impl<'a> PolyhedronPose<'a> {
     /// Outward unit normal of triangle `t` in the world frame.
     #[inline]
     pub fn normal(&self, t: u32) -> V3 {
-        (self.normal_map * self.shape.normals()[t as usize]).normalize()
+        self.normal_direction(t).normalize()
+    }
+
+    /// Outward normal of triangle `t` in the world frame, of no particular length.
+    #[inline]
+    pub fn normal_direction(&self, t: u32) -> V3 {
+        self.normal_map * self.shape.normals()[t as usize]
     }
 }
 
