@@ -229,28 +229,19 @@ fn library(source: &str, faces: usize, json: bool) -> anyhow::Result<()> {
         )?;
     }
     let s = |key: &str, stat: &str| summary[key][stat].as_f64().unwrap_or(f64::NAN);
-    outln!(
-        "{:<24} {:>9} {:>6.3} {:>6.3} {:>10.3} {:>10} {:>9.3} {:>8.3}",
-        "mean",
-        "",
-        s("FL", "mean"),
-        s("EL", "mean"),
-        s("sphericity", "mean"),
-        "",
-        s("relative_sphericity", "mean"),
-        s("volume_ratio", "mean")
-    )?;
-    outln!(
-        "{:<24} {:>9} {:>6.3} {:>6.3} {:>10.3} {:>10} {:>9.3} {:>8.3}",
-        "standard deviation",
-        "",
-        s("FL", "std"),
-        s("EL", "std"),
-        s("sphericity", "std"),
-        "",
-        s("relative_sphericity", "std"),
-        s("volume_ratio", "std")
-    )?;
+    for (label, stat) in [("mean", "mean"), ("standard deviation", "std")] {
+        outln!(
+            "{:<24} {:>9} {:>6.3} {:>6.3} {:>10.3} {:>10} {:>9.3} {:>8.3}",
+            label,
+            "",
+            s("FL", stat),
+            s("EL", stat),
+            s("sphericity", stat),
+            "",
+            s("relative_sphericity", stat),
+            s("volume_ratio", stat)
+        )?;
+    }
     outln!(
         "{:<24} {:>9} {:>6.3} {:>6.3}   (standard deviations {:.3}, {:.3}: the 63 scans of the paper)",
         "Table 2 (Rhine)",
