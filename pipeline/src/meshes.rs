@@ -25,7 +25,7 @@ pub fn is_builtin(source: &str) -> bool {
 /// and stored as an absolute path.
 pub fn load(source: &str, faces: usize, base: &Path) -> anyhow::Result<MeshLibrary> {
     let source = resolve(source, base)?;
-    let meshes: Vec<UnitMesh> = prepare(&source, faces)?.into_iter().map(|(_, mesh)| mesh).collect();
+    let meshes = unnamed(prepare(&source, faces)?);
     Ok(MeshLibrary { digest: digest(&meshes), source, faces, meshes })
 }
 
@@ -44,11 +44,10 @@ pub fn resolve(source: &str, base: &Path) -> anyhow::Result<String> {
 
 /// Fills in the meshes of a library read back from the store and checks they are the same.
 pub fn reload(library: &mut MeshLibrary) -> anyhow::Result<()> {
-    let meshes: Vec<UnitMesh> = prepare(&library.source, library.faces)
-        .with_context(|| format!("grains.meshes: the meshes of {} cannot be read", library.source))?
-        .into_iter()
-        .map(|(_, mesh)| mesh)
-        .collect();
+    let meshes = unnamed(
+        prepare(&library.source, library.faces)
+            .with_context(|| format!("grains.meshes: the meshes of {} cannot be read", library.source))?,
+    );
     if digest(&meshes) != library.digest {
         if is_builtin(&library.source) {
             return Err(anyhow!(
@@ -93,6 +92,11 @@ pub fn prepare(source: &str, faces: usize) -> anyhow::Result<Vec<(String, UnitMe
             Ok((name, unit))
         })
         .collect()
+}
+
+/// The meshes without their names, as a library keeps them.
+fn unnamed(named: Vec<(String, UnitMesh)>) -> Vec<UnitMesh> {
+    named.into_iter().map(|(_, mesh)| mesh).collect()
 }
 
 /// SHA-256 of the normalised meshes: vertices, triangles and own forms, in order.

@@ -161,6 +161,18 @@ fn distribution_record(d: &DistributionArgs) -> anyhow::Result<Map<String, Value
     Ok(record)
 }
 
+/// A column of `forms --library`: JSON key, table heading, value of a mesh.
+type Column = (&'static str, &'static str, fn(&Angularity) -> f64);
+
+const LIBRARY_COLUMNS: [Column; 6] = [
+    ("FL", "FL", |a| a.form.s / a.form.i),
+    ("EL", "EL", |a| a.form.i / a.form.l),
+    ("sphericity", "sphericity", |a| a.sphericity),
+    ("ellipsoid_sphericity", "ellipsoid", |a| a.ellipsoid_sphericity),
+    ("relative_sphericity", "relative", Angularity::relative_sphericity),
+    ("volume_ratio", "volume", |a| a.volume_ratio),
+];
+
 /// One row per mesh of a library (own form, sphericities, angularity) and their means and
 /// standard deviations beside the Rhine form distribution of Table 2, which the paper's 63 scans
 /// follow: what a packing poured from the library's own forms draws from.
@@ -173,86 +185,60 @@ fn library(source: &str, faces: usize, json: bool) -> anyhow::Result<()> {
         // A folder's meshes are named by their file names: the folder heads the table.
         let name = std::path::Path::new(&path).file_name().map_or(path.clone(), |n| n.to_string_lossy().into_owned());
         let mesh = unit.rescaled(&unit.original_form());
-        let a = Angularity::of(&mesh).with_context(|| format!("{source}: {name}"))?;
-        rows.push(json!({
-            "mesh": name,
-            "triangles": mesh.triangles().len(),
-            "FL": a.form.s / a.form.i,
-            "EL": a.form.i / a.form.l,
-            "sphericity": a.sphericity,
-            "ellipsoid_sphericity": a.ellipsoid_sphericity,
-            "relative_sphericity": a.relative_sphericity(),
-            "volume_ratio": a.volume_ratio,
+        let angularity = Angularity::of(&mesh).with_context(|| format!("{source}: {name}"))?;
+        rows.push((name, mesh.triangles().len(), angularity));
+    }
+    let summary: Vec<(f64, f64)> = LIBRARY_COLUMNS
+        .iter()
+        .map(|(_, _, value)| mean_std(&rows.iter().map(|(_, _, a)| value(a)).collect::<Vec<_>>()))
+        .collect();
+    let table2 = RHINE_FORMS;
+    if json {
+        let meshes: Vec<Value> = rows
+            .iter()
+            .map(|(name, triangles, a)| {
+                let mut row = Map::new();
+                row.insert("mesh".into(), json!(name));
+                row.insert("triangles".into(), json!(triangles));
+                for (key, _, value) in &LIBRARY_COLUMNS {
+                    row.insert((*key).into(), json!(value(a)));
+                }
+                Value::Object(row)
+            })
+            .collect();
+        let summary: Map<String, Value> = LIBRARY_COLUMNS
+            .iter()
+            .zip(&summary)
+            .map(|((key, _, _), (mean, std))| ((*key).into(), json!({"mean": mean, "std": std})))
+            .collect();
+        return print_json(&json!({
+            "library": source,
+            "faces": faces,
+            "meshes": meshes,
+            "summary": summary,
+            "table2": {"mu_FL": table2.mu_fl, "sigma_FL": table2.sigma_fl, "mu_EL": table2.mu_el, "sigma_EL": table2.sigma_el},
         }));
     }
-    let column = |key: &str| rows.iter().map(|r| r[key].as_f64().unwrap_or(f64::NAN)).collect::<Vec<_>>();
-    let mut summary = Map::new();
-    for key in ["FL", "EL", "sphericity", "relative_sphericity", "volume_ratio"] {
-        let (mean, std) = mean_std(&column(key));
-        summary.insert(key.into(), json!({"mean": mean, "std": std}));
-    }
-    let table2 = RHINE_FORMS;
-    let record = json!({
-        "library": source,
-        "faces": faces,
-        "meshes": rows,
-        "summary": summary,
-        "table2": {"mu_FL": table2.mu_fl, "sigma_FL": table2.sigma_fl, "mu_EL": table2.mu_el, "sigma_EL": table2.sigma_el},
-    });
-    if json {
-        return print_json(&record);
-    }
+    let line = |label: &str, triangles: &str, values: &mut dyn Iterator<Item = String>| {
+        let values: Vec<String> = values.collect();
+        outln!("{label:<24} {triangles:>9} {}", values.join(" "))
+    };
     outln!("library {source} (at most {faces} faces)")?;
-    outln!(
-        "{:<24} {:>9} {:>6} {:>6} {:>10} {:>10} {:>9} {:>8}",
-        "mesh",
-        "triangles",
-        "FL",
-        "EL",
-        "sphericity",
-        "ellipsoid",
-        "relative",
-        "volume"
-    )?;
-    for r in &rows {
-        let f = |key: &str| r[key].as_f64().unwrap_or(f64::NAN);
-        outln!(
-            "{:<24} {:>9} {:>6.3} {:>6.3} {:>10.3} {:>10.3} {:>9.3} {:>8.3}",
-            r["mesh"].as_str().unwrap_or_default(),
-            r["triangles"].as_u64().unwrap_or_default(),
-            f("FL"),
-            f("EL"),
-            f("sphericity"),
-            f("ellipsoid_sphericity"),
-            f("relative_sphericity"),
-            f("volume_ratio")
+    line("mesh", "triangles", &mut LIBRARY_COLUMNS.iter().map(|(_, heading, _)| format!("{heading:>10}")))?;
+    for (name, triangles, a) in &rows {
+        line(
+            name,
+            &triangles.to_string(),
+            &mut LIBRARY_COLUMNS.iter().map(|(_, _, value)| format!("{:>10.3}", value(a))),
         )?;
     }
-    let s = |key: &str, stat: &str| summary[key][stat].as_f64().unwrap_or(f64::NAN);
-    for (label, stat) in [("mean", "mean"), ("standard deviation", "std")] {
-        outln!(
-            "{:<24} {:>9} {:>6.3} {:>6.3} {:>10.3} {:>10} {:>9.3} {:>8.3}",
-            label,
-            "",
-            s("FL", stat),
-            s("EL", stat),
-            s("sphericity", stat),
-            "",
-            s("relative_sphericity", stat),
-            s("volume_ratio", stat)
-        )?;
-    }
+    line("mean", "", &mut summary.iter().map(|(mean, _)| format!("{mean:>10.3}")))?;
+    line("standard deviation", "", &mut summary.iter().map(|(_, std)| format!("{std:>10.3}")))?;
+    line("Table 2 (Rhine)", "", &mut [table2.mu_fl, table2.mu_el].iter().map(|m| format!("{m:>10.3}")))?;
     outln!(
-        "{:<24} {:>9} {:>6.3} {:>6.3}   (standard deviations {:.3}, {:.3}: the 63 scans of the paper)",
-        "Table 2 (Rhine)",
-        "",
-        table2.mu_fl,
-        table2.mu_el,
+        "Table 2: the paper's 63 scans (standard deviations {:.3}, {:.3}). sphericity: Wadell's, of the mesh and of its mass-equivalent ellipsoid (Appendix A); relative: their ratio, 1 for an ellipsoid and lower the more angular the grain at its form; volume: the mesh's over that ellipsoid's",
         table2.sigma_fl,
         table2.sigma_el
-    )?;
-    outln!(
-        "sphericity: Wadell's, of the mesh and of its mass-equivalent ellipsoid (Appendix A); relative: their ratio, 1 for an ellipsoid and lower the more angular the grain at its form; volume: the mesh's over that ellipsoid's"
     )?;
     Ok(())
 }

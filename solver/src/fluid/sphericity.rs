@@ -74,11 +74,16 @@ pub fn polyhedron_surface(p: &Polyhedron) -> f64 {
         .sum()
 }
 
+/// Surface of the sphere of this volume, π^(1/3) (6V)^(2/3): the numerator of Wadell's
+/// sphericity.
+pub fn equal_volume_sphere_surface(volume: f64) -> f64 {
+    PI.cbrt() * (6.0 * volume).powf(2.0 / 3.0)
+}
+
 /// Sphericity of a shape; a bonded grain's spheres touch at points, so its surface is the sum
 /// of theirs.
 pub fn sphericity(shape: &Shape) -> f64 {
-    let volume = shape.volume();
-    let equivalent = PI.cbrt() * (6.0 * volume).powf(2.0 / 3.0);
+    let equivalent = equal_volume_sphere_surface(shape.volume());
     let surface = match shape {
         Shape::Sphere { .. } => return 1.0,
         Shape::Ellipsoid { semi_axes } => ellipsoid_surface(semi_axes),

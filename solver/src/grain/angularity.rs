@@ -6,12 +6,10 @@
 //! Meshes and ellipsoids of one form pack differently (§6.4, Fig. 10): this is the property in
 //! which two mesh libraries of the same forms can still differ.
 
-use std::f64::consts::PI;
-
 use super::ellipsoid::EquivalentEllipsoid;
 use super::form::{FormError, FormParameters};
 use super::mesh::TriMesh;
-use crate::fluid::sphericity::ellipsoid_surface;
+use crate::fluid::sphericity::{ellipsoid_surface, equal_volume_sphere_surface};
 
 /// Sphericities of a grain mesh and of its mass-equivalent ellipsoid, with the volume ratio.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,12 +35,12 @@ impl Angularity {
                 0.5 * (b - a).cross(&(c - a)).norm()
             })
             .sum();
-        let s = ellipsoid.semi_axes;
-        let ellipsoid_volume = 4.0 / 3.0 * PI * s.x * s.y * s.z;
+        let ellipsoid_volume = form.ellipsoid_volume();
         Ok(Self {
             form,
-            sphericity: sphere_surface(props.volume) / surface,
-            ellipsoid_sphericity: sphere_surface(ellipsoid_volume) / ellipsoid_surface(&s),
+            sphericity: equal_volume_sphere_surface(props.volume) / surface,
+            ellipsoid_sphericity: equal_volume_sphere_surface(ellipsoid_volume)
+                / ellipsoid_surface(&ellipsoid.semi_axes),
             volume_ratio: props.volume / ellipsoid_volume,
         })
     }
@@ -51,9 +49,4 @@ impl Angularity {
     pub fn relative_sphericity(&self) -> f64 {
         self.sphericity / self.ellipsoid_sphericity
     }
-}
-
-/// Surface of the sphere of this volume: π^(1/3) (6V)^(2/3).
-fn sphere_surface(volume: f64) -> f64 {
-    PI.cbrt() * (6.0 * volume).powf(2.0 / 3.0)
 }
