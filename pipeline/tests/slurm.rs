@@ -207,8 +207,9 @@ fn killed_submitters_scancel_requeue_and_preemption_lose_nothing_and_run_nothing
     let Some(slurm) = slurm() else { return };
     let _one = CLUSTER.lock().unwrap_or_else(|e| e.into_inner());
     let dir = tempfile::tempdir().unwrap();
-    // Six tiny packings and six of ≈ 5 s, long enough to be interrupted while they run.
-    let grid = "grid:\n  process.shaking.duration: [0.05, 2.0]\nseeds: [1, 2, 3, 4, 5, 6]\n";
+    // Six tiny packings and six of 5–10 s, long enough to be interrupted while they run (with 2 s
+    // of shaking, 3 s on a fast CPU, a loaded slurmctld once let them end before it preempted).
+    let grid = "grid:\n  process.shaking.duration: [0.05, 4.0]\nseeds: [1, 2, 3, 4, 5, 6]\n";
     let file = write(dir.path(), "chaos.yaml", &sphere_campaign("chaos", 0.05, grid));
     let reference = std::thread::spawn({
         let (file, dir) = (file.clone(), dir.path().to_path_buf());
@@ -233,7 +234,7 @@ fn killed_submitters_scancel_requeue_and_preemption_lose_nothing_and_run_nothing
     assert!(found.iter().all(|t| (t["state"] == "running") == t["task"].is_string()), "each with its task: {found:?}");
     let long: Vec<String> = rows(db, "chaos")
         .into_iter()
-        .filter(|r| r.parameters["process.shaking.duration"] == 2.0)
+        .filter(|r| r.parameters["process.shaking.duration"] == 4.0)
         .map(|r| r.job_id)
         .collect();
 
