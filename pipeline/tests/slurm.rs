@@ -207,8 +207,8 @@ fn killed_submitters_scancel_requeue_and_preemption_lose_nothing_and_run_nothing
     let Some(slurm) = slurm() else { return };
     let _one = CLUSTER.lock().unwrap_or_else(|e| e.into_inner());
     let dir = tempfile::tempdir().unwrap();
-    // Six tiny packings and six of 5–10 s, long enough to be interrupted while they run (with 2 s
-    // of shaking, 3 s on a fast CPU, a loaded slurmctld once let them end before it preempted).
+    // Six tiny packings and six of several seconds, long enough to be interrupted while they run
+    // (with 2 s of shaking they took ~3 s on a fast CPU, and ended before a loaded slurmctld preempted).
     let grid = "grid:\n  process.shaking.duration: [0.05, 4.0]\nseeds: [1, 2, 3, 4, 5, 6]\n";
     let file = write(dir.path(), "chaos.yaml", &sphere_campaign("chaos", 0.05, grid));
     let reference = std::thread::spawn({
