@@ -27,6 +27,8 @@ pub struct JobRecord {
     pub parameters: BTreeMap<String, serde_json::Value>,
     /// "FL", "inv_FL", …, "WFI", "inv_WFI" → (number-based mean, std) over the packing's grains.
     pub grain_statistics: BTreeMap<String, (f64, f64)>,
+    /// The Table 3 size case of the grains' sieve curve ("U1" … "B70"); None for another curve.
+    pub size_case: Option<String>,
     /// Measured porosity, when the campaign gives one.
     pub experiment: Option<Experiment>,
     /// The fluid forces the packing was deposited with, in words ("drag, still water"); None:

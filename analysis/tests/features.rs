@@ -14,6 +14,7 @@ fn record(id: &str, porosity: f64, grains: &[(f64, f64)]) -> JobRecord {
         profile: vec![],
         parameters: BTreeMap::new(),
         grain_statistics: grain_statistics(grains),
+        size_case: None,
         experiment: None,
         fluid: None,
         imbrication: None,

@@ -70,6 +70,7 @@ fn mixture_campaign() -> Vec<JobRecord> {
                             ("seed".to_string(), json!(1)),
                         ]),
                         grain_statistics: stats,
+                        size_case: None,
                         experiment: None,
                         fluid: None,
                         imbrication: None,
@@ -238,6 +239,7 @@ fn validation_campaign() -> Vec<JobRecord> {
                 profile: vec![],
                 parameters: BTreeMap::from([("grains.size".into(), json!(case)), ("seed".into(), json!(seed + 1))]),
                 grain_statistics: grain_statistics(&[(fl, el); 3]),
+                size_case: None,
                 experiment: Some(experiment),
                 fluid: None,
                 imbrication: None,
@@ -309,10 +311,9 @@ fn too_few_packings_still_give_a_report_that_says_why() {
     assert_eq!(std::fs::read_to_string(empty.dataset).unwrap(), "job_id,porosity\n");
 }
 
-/// Fig. 10: two forms packed as ellipsoids and as meshes, porosities chosen so that means,
-/// spreads and differences are worked by hand.
-#[test]
-fn a_campaign_over_grain_shapes_compares_them_at_equal_form() {
+/// Two forms packed as ellipsoids and as meshes, of the size case `size_case`, porosities chosen
+/// so that means, spreads and differences are worked by hand.
+fn shape_records(size_case: Option<&str>) -> Vec<JobRecord> {
     let runs = [
         ("ellipsoid", 0.8, [0.360, 0.364].as_slice()),
         ("mesh", 0.8, &[0.350, 0.352]),
@@ -332,14 +333,21 @@ fn a_campaign_over_grain_shapes_compares_them_at_equal_form() {
                     ("seed".into(), json!(seed + 1)),
                 ]),
                 grain_statistics: grain_statistics(&[(form, form); 3]),
+                size_case: size_case.map(String::from),
                 experiment: None,
                 fluid: None,
                 imbrication: None,
             });
         }
     }
+    records
+}
+
+/// Fig. 10 for grains of no Table 3 case: the shapes side by side, without a paper model.
+#[test]
+fn a_campaign_over_grain_shapes_compares_them_at_equal_form() {
     let out = tempfile::tempdir().unwrap();
-    let files = report("shapes", &records, out.path());
+    let files = report("shapes", &shape_records(None), out.path());
     let md = std::fs::read_to_string(&files.markdown).unwrap();
     // L/S = 1/(FL·EL): 1/0.64 = 1.5625 and 1/0.25 = 4. Form 0.8: 0.362 ± 0.002 against
     // 0.351 ± 0.001, difference −0.011; form 0.5: 0.400 against 0.407 ± 0.00163, +0.007.
@@ -353,9 +361,48 @@ fn a_campaign_over_grain_shapes_compares_them_at_equal_form() {
         "{md}"
     );
     assert!(md.contains("RMS difference `mesh` − `ellipsoid` over 2 setups: 0.0092."), "{md}");
+    assert!(!md.contains("Eq. 17"), "{md}");
     assert!(files.figures.iter().any(|f| f.ends_with("shapes.svg")));
     let svg = check_html(out.path(), 3);
     assert!(svg.contains("Porosity by grain shape"));
+}
+
+/// Fig. 10 for single forms of U1: Eq. 17 beside each setup, and each shape's distance from it.
+#[test]
+fn single_forms_of_a_paper_case_are_compared_with_its_single_form_model() {
+    let out = tempfile::tempdir().unwrap();
+    let files = report("shapes-u1", &shape_records(Some("U1")), out.path());
+    let md = std::fs::read_to_string(&files.markdown).unwrap();
+    // Eq. 17 at FL = EL = 0.8 (EQ⁻¹ = 1.5625, EL⁻¹ = 1.25): 0.0296875 + 0.0175 + 0.278 = 0.3251875;
+    // at 0.5 (4, 2): 0.076 + 0.028 + 0.278 = 0.382. Ellipsoids lie 0.0368125 and 0.018 above it
+    // (mean 0.0274), meshes 0.0258125 and 0.025 (mean 0.0254).
+    assert!(
+        md.contains(
+            r#"| grains.form = {"fl":0.8,"el":0.8} | 1.56 | 0.325 | 0.362 ± 0.002 (2) | 0.351 ± 0.001 (2) | -0.011 |"#
+        ),
+        "{md}"
+    );
+    assert!(md.contains(r#"| grains.form = {"fl":0.5,"el":0.5} | 4.00 | 0.382 | 0.400 (1) |"#), "{md}");
+    assert!(md.contains("n = 0.019 EQ⁻¹ + 0.014 EL⁻¹ + 0.278"), "{md}");
+    assert!(
+        md.contains(
+            "Against Eq. 17: `ellipsoid` +0.0274 on average, mean absolute difference 0.0274 (2 setups); \
+             `mesh` +0.0254 on average, mean absolute difference 0.0254 (2 setups)."
+        ),
+        "{md}"
+    );
+    let svg = check_html(out.path(), 3);
+    assert!(svg.contains("Eq. 17 (paper&apos;s fit, meshes)") || svg.contains("Eq. 17 (paper's fit, meshes)"), "{svg}");
+
+    // Grains of two cases, or drawn from a form distribution, have no one single-form model.
+    let mut mixed = shape_records(Some("U1"));
+    mixed[0].size_case = Some("U7".into());
+    let md = std::fs::read_to_string(report("mixed", &mixed, out.path()).markdown).unwrap();
+    assert!(!md.contains("Eq. 17"), "{md}");
+    let mut spread = shape_records(Some("U1"));
+    spread[0].grain_statistics = grain_statistics(&[(0.7, 0.8), (0.9, 0.8)]);
+    let md = std::fs::read_to_string(report("spread", &spread, out.path()).markdown).unwrap();
+    assert!(!md.contains("Eq. 17"), "{md}");
 }
 
 /// Packings with and without drag, paired by seed; numbers worked by hand.
@@ -377,6 +424,7 @@ fn a_campaign_with_and_without_drag_compares_them_seed_by_seed() {
                     ("seed".into(), json!(seed)),
                 ]),
                 grain_statistics: grain_statistics(&[(0.6, 0.7); 3]),
+                size_case: None,
                 experiment: None,
                 fluid: fluid.map(String::from),
                 imbrication: None,
@@ -429,6 +477,7 @@ fn the_imbrication_of_each_setup_is_summed_over_its_runs() {
                     ("seed".into(), json!(seed + 1)),
                 ]),
                 grain_statistics: grain_statistics(&[(0.8, 0.5); 3]),
+                size_case: None,
                 experiment: None,
                 fluid: Some(fluid.into()),
                 imbrication: Some(f),

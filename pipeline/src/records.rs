@@ -111,8 +111,9 @@ pub fn result_rows(result: &PackingResult) -> (JobResult, Vec<GrainStatistic>) {
     (row, statistics)
 }
 
-/// A job as the analysis reads it; None for a job without a result.
-pub fn job_record(row: &ExportRow) -> anyhow::Result<Option<JobRecord>> {
+/// A job as the analysis reads it, its grains of the Table 3 case `size_case`; None for a job
+/// without a result.
+pub fn job_record(row: &ExportRow, size_case: Option<&str>) -> anyhow::Result<Option<JobRecord>> {
     let Some(result) = &row.result else { return Ok(None) };
     let profile: Vec<ProfilePoint> = serde_json::from_value(result.profile.clone())
         .with_context(|| format!("job {}: the stored porosity profile is not [{{z, n}}, …]", row.job_id))?;
@@ -138,6 +139,7 @@ pub fn job_record(row: &ExportRow) -> anyhow::Result<Option<JobRecord>> {
             .iter()
             .map(|s| (s.name.clone(), (s.mean, s.std)))
             .collect::<BTreeMap<_, _>>(),
+        size_case: size_case.map(String::from),
         experiment: row.experiment_porosity.map(|porosity| Experiment { porosity, std: row.experiment_std }),
         fluid: fluid.map(|f| f.describe()),
         imbrication,
@@ -192,14 +194,14 @@ mod tests {
 
     #[test]
     fn a_stored_row_becomes_a_record_and_an_unreadable_profile_an_error() {
-        let record = job_record(&row(json!([{"z": 0.0005, "n": 0.5}]))).unwrap().unwrap();
+        let record = job_record(&row(json!([{"z": 0.0005, "n": 0.5}])), None).unwrap().unwrap();
         assert_eq!(record.profile, [ProfilePoint { z: 0.0005, n: 0.5 }]);
         assert_eq!(record.experiment, Some(Experiment { porosity: 0.4, std: None }));
         assert_eq!(record.grain_statistics["FL"], (0.6, 0.05));
-        let error = job_record(&row(json!({"z": 1}))).unwrap_err().to_string();
+        let error = job_record(&row(json!({"z": 1})), None).unwrap_err().to_string();
         assert!(error.contains("job j1") && error.contains("porosity profile"), "{error}");
         let pending = ExportRow { result: None, ..row(json!([])) };
-        assert_eq!(job_record(&pending).unwrap(), None);
+        assert_eq!(job_record(&pending, None).unwrap(), None);
     }
 
     #[test]
@@ -213,9 +215,9 @@ mod tests {
         });
         let column = serde_json::to_value(FluidColumn::of(&spec).unwrap()).unwrap();
         assert_eq!(column["flow"], json!({"kind": "logarithmic", "shear_velocity": 0.05, "roughness": 2e-4}));
-        let record = job_record(&ExportRow { fluid: Some(column), ..row(json!([])) }).unwrap().unwrap();
+        let record = job_record(&ExportRow { fluid: Some(column), ..row(json!([])) }, None).unwrap().unwrap();
         assert_eq!(record.fluid.as_deref(), Some("drag and lift, logarithmic current, u* = 0.05 m/s, z₀ = 0.0002 m"));
-        let error = job_record(&ExportRow { fluid: Some(json!({"flow": 1})), ..row(json!([])) }).unwrap_err();
+        let error = job_record(&ExportRow { fluid: Some(json!({"flow": 1})), ..row(json!([])) }, None).unwrap_err();
         assert!(error.to_string().contains("stored fluid"), "{error}");
     }
 }

@@ -280,3 +280,35 @@ fn bad_campaigns_and_databases_are_refused_clearly() {
     assert_eq!(std::fs::read(&corrupt).unwrap(), before);
     fails(&["status", "--db", dir.path().join("missing.db").to_str().unwrap()], &["missing.db", "no such database"]);
 }
+
+/// The report finds each job's size case in its stored spec: single forms of U1 stand beside
+/// Eq. 17, worked by hand, and a custom sieve curve of the same sizes gets no paper model.
+#[test]
+fn a_report_of_single_forms_of_u1_sets_them_beside_eq_17() {
+    let dir = tempfile::tempdir().unwrap();
+    let db = &path_in(dir.path(), "sedpack.db");
+    let u1 = sphere_campaign("u1-shapes", 0.02, "grid:\n  grains.shape: [ellipsoid, bonded-spheres]\n")
+        .replace("shape: sphere", "shape: ellipsoid\n  form: {fl: 0.6, el: 0.6}")
+        .replace("{sieves: [0.0056, 0.008], fractions: [1.0]}", "U1");
+    let custom = u1.replace("u1-shapes", "custom-shapes").replace(
+        "size: U1",
+        // U1's class with its neighbours left empty: the same grains, but not Table 3's curve.
+        "size: {sieves: [0.004, 0.0056, 0.008], fractions: [0.0, 1.0]}",
+    );
+    for (name, text) in [("u1-shapes", &u1), ("custom-shapes", &custom)] {
+        let file = write(dir.path(), &format!("{name}.yaml"), text);
+        ok(&["run", &file, "--db", db, "--workers", "2", "--quiet"]);
+        let out = dir.path().join(name);
+        ok(&["report", name, "--db", db, "--out", out.to_str().unwrap()]);
+        let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+        assert!(md.contains("## Grain shape at equal form (Fig. 10)"), "{md}");
+        // FL = EL = 0.6: EQ⁻¹ = 1/0.36, EL⁻¹ = 1/0.6: 0.019/0.36 + 0.014/0.6 + 0.278 = 0.35411.
+        let row = md.lines().find(|l| l.starts_with("| all jobs | 2.78 |")).unwrap_or_else(|| panic!("{md}"));
+        if name == "u1-shapes" {
+            assert!(row.starts_with("| all jobs | 2.78 | 0.354 |"), "{row}");
+            assert!(md.contains("Against Eq. 17: `ellipsoid`"), "{md}");
+        } else {
+            assert!(!md.contains("Eq. 17"), "{md}");
+        }
+    }
+}

@@ -19,6 +19,7 @@ use crate::correlation::CorrelationMatrix;
 use crate::dataset::{Dataset, FeatureKind};
 use crate::form_factors::symbol;
 use crate::model::LinearModel;
+use crate::paper::paper_model;
 use crate::plots::{self, PlotError, ScatterPlot, ZinggPacking};
 use crate::record::{CampaignSummary, Experiment, JobRecord};
 use crate::selection::{Candidate, Selection, SelectionOptions, set_label};
@@ -356,20 +357,43 @@ fn mean_std(values: &[f64]) -> (f64, f64) {
 /// (L/S, porosity) of each run of one grain shape in one setup.
 type ShapeRuns = Vec<(f64, f64)>;
 
+/// One setup of the shape comparison: its label, (L/S, L/I) of every run, the runs per shape.
+type ShapeSetup = (String, Vec<(f64, f64)>, Vec<ShapeRuns>);
+
+/// The paper's single-form model of the records' size case (Eqs. 17–19), where every record is
+/// a packing of one form (flatness and elongation without spread) of that one Table 3 case.
+fn paper_single_form_model<'a>(records: impl IntoIterator<Item = &'a JobRecord>) -> Option<LinearModel> {
+    let mut case = None;
+    for r in records {
+        let single = ["FL", "EL"].iter().all(|f| r.grain_statistics.get(*f).is_some_and(|s| s.1 < 1e-9));
+        if !single || r.size_case.is_none() || (case.is_some() && case != r.size_case.as_ref()) {
+            return None;
+        }
+        case = r.size_case.as_ref();
+    }
+    paper_model(&format!("paper-sf-{}", case?)).map(|m| m.model)
+}
+
 /// Fig. 10: where the campaign varies `grains.shape`, each setup's porosity per shape against
-/// its mean inverse equancy L/S, and how far the shapes lie from the first one.
+/// its mean inverse equancy L/S, how far the shapes lie from the first one and, for single forms
+/// of U1, U7 or B50, from the paper's single-form model of that case.
 fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), ReportError> {
     const SHAPE: &str = "grains.shape";
     let Some((_, shapes)) = varied_parameters(records).into_iter().find(|(k, _)| k == SHAPE) else {
         return Ok(());
     };
-    // setup (the parameters but shape and seed) → per shape: (L/S, porosity) of its runs.
-    let mut setups: Vec<(String, Vec<ShapeRuns>)> = Vec::new();
-    for r in records {
-        let (Some(shape), Some(&(inv_eq, _))) = (r.parameters.get(SHAPE), r.grain_statistics.get("inv_EQ")) else {
-            continue;
-        };
-        let k = shapes.iter().position(|s| *s == value_text(shape)).expect("a varied value");
+    let with_form = |r: &&JobRecord| {
+        r.parameters.contains_key(SHAPE)
+            && r.grain_statistics.contains_key("inv_EQ")
+            && r.grain_statistics.contains_key("inv_EL")
+    };
+    let paper = paper_single_form_model(records.iter().filter(with_form));
+    // setup (the parameters but shape and seed) → (L/S, L/I) of every run, and per shape the
+    // (L/S, porosity) of its runs.
+    let mut setups: Vec<ShapeSetup> = Vec::new();
+    for r in records.iter().filter(with_form) {
+        let (inv_eq, inv_el) = (r.grain_statistics["inv_EQ"].0, r.grain_statistics["inv_EL"].0);
+        let k = shapes.iter().position(|s| *s == value_text(&r.parameters[SHAPE])).expect("a varied value");
         let label = r
             .parameters
             .iter()
@@ -380,17 +404,41 @@ fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), R
         let at = match setups.iter().position(|s| s.0 == label) {
             Some(at) => at,
             None => {
-                setups.push((label, vec![Vec::new(); shapes.len()]));
+                setups.push((label, Vec::new(), vec![Vec::new(); shapes.len()]));
                 setups.len() - 1
             }
         };
-        setups[at].1[k].push((inv_eq, r.porosity));
+        setups[at].1.push((inv_eq, inv_el));
+        setups[at].2[k].push((inv_eq, r.porosity));
     }
+    // The paper's model at each setup's mean form.
+    let predicted: Vec<Option<f64>> = setups
+        .iter()
+        .map(|(_, forms, _)| {
+            let model = paper.as_ref()?;
+            let mean = |f: fn(&(f64, f64)) -> f64| forms.iter().map(f).sum::<f64>() / forms.len() as f64;
+            let values = BTreeMap::from([("inv_EQ".to_string(), mean(|f| f.0)), ("inv_EL".to_string(), mean(|f| f.1))]);
+            model.predict(&values).ok()
+        })
+        .collect();
+    let equation =
+        paper.as_ref().map(|m| m.campaign.clone().unwrap_or_default().replace("Rettinger et al. (2022), ", ""));
     blocks.push(Block::Heading("Grain shape at equal form (Fig. 10)".into()));
-    blocks.push(Block::Paragraph(format!(
+    let mut intro = format!(
         "Each setup's packings per grain shape: the mean inverse equancy L/S of their grains, and their porosity (mean ± population std over the seeds, runs in brackets; a single run shows its value alone). The differences are to the first shape, `{}`; RMS over the setups where both have runs (the paper finds ~0.008 between meshes and their equivalent ellipsoids).",
         shapes[0]
-    )));
+    );
+    if let (Some(model), Some(equation)) = (&paper, &equation) {
+        intro.push_str(&format!(
+            " Beside them, the paper's {equation} (`{}`), n = {:.3} EQ⁻¹ {} {:.3} EL⁻¹ + {:.3}: its fit to its own single-form mesh packings of the case, in the periodic domain shaken t_s = 6 s, at the setup's form.",
+            model.name,
+            model.coefficients[0],
+            if model.coefficients[1] < 0.0 { "−" } else { "+" },
+            model.coefficients[1].abs(),
+            model.intercept
+        ));
+    }
+    blocks.push(Block::Paragraph(intro));
     let cell = |runs: &[(f64, f64)]| {
         if runs.is_empty() {
             return "–".to_string();
@@ -402,17 +450,20 @@ fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), R
             n => format!("{mean:.3} ± {std:.3} ({n})"),
         }
     };
+    let mean =
+        |runs: &[(f64, f64)]| (!runs.is_empty()).then(|| mean_std(&runs.iter().map(|r| r.1).collect::<Vec<_>>()).0);
     let mut squares = vec![Vec::new(); shapes.len()];
+    let mut from_paper = vec![Vec::new(); shapes.len()];
     let rows = setups
         .iter()
-        .map(|(label, per_shape)| {
-            let all: Vec<f64> = per_shape.iter().flatten().map(|r| r.0).collect();
+        .zip(&predicted)
+        .map(|((label, forms, per_shape), predicted)| {
             let mut row = vec![if label.is_empty() { "all jobs".into() } else { label.clone() }];
-            row.push(format!("{:.2}", mean_std(&all).0));
+            row.push(format!("{:.2}", mean_std(&forms.iter().map(|f| f.0).collect::<Vec<_>>()).0));
+            if paper.is_some() {
+                row.push(predicted.map_or("–".into(), |p| format!("{p:.3}")));
+            }
             row.extend(per_shape.iter().map(|runs| cell(runs)));
-            let mean = |runs: &[(f64, f64)]| {
-                (!runs.is_empty()).then(|| mean_std(&runs.iter().map(|r| r.1).collect::<Vec<_>>()).0)
-            };
             for (k, runs) in per_shape.iter().enumerate().skip(1) {
                 row.push(match (mean(&per_shape[0]), mean(runs)) {
                     (Some(first), Some(this)) => {
@@ -422,10 +473,18 @@ fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), R
                     _ => "–".into(),
                 });
             }
+            for (k, runs) in per_shape.iter().enumerate() {
+                if let (Some(p), Some(this)) = (predicted, mean(runs)) {
+                    from_paper[k].push(this - p);
+                }
+            }
             row
         })
         .collect();
     let mut header = vec!["setup".to_string(), "L/S".to_string()];
+    if let Some(equation) = &equation {
+        header.push(format!("{equation} (paper, meshes)"));
+    }
     header.extend(shapes.iter().map(|s| format!("n, `{s}`")));
     header.extend(shapes.iter().skip(1).map(|s| format!("`{s}` − `{}`", shapes[0])));
     blocks.push(Block::Table { header, rows });
@@ -438,15 +497,32 @@ fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), R
             (sq.iter().sum::<f64>() / sq.len() as f64).sqrt()
         )));
     }
-    let series: Vec<plots::Series> = shapes
+    if let Some(equation) = &equation {
+        let summaries: Vec<String> = shapes
+            .iter()
+            .zip(&from_paper)
+            .filter(|(_, d)| !d.is_empty())
+            .map(|(shape, d)| {
+                let n = d.len() as f64;
+                format!(
+                    "`{shape}` {:+.4} on average, mean absolute difference {:.4} ({} setups)",
+                    d.iter().sum::<f64>() / n,
+                    d.iter().map(|x| x.abs()).sum::<f64>() / n,
+                    d.len()
+                )
+            })
+            .collect();
+        blocks.push(Block::Paragraph(format!("Against {equation}: {}.", summaries.join("; "))));
+    }
+    let mut series: Vec<plots::Series> = shapes
         .iter()
         .enumerate()
         .map(|(k, shape)| plots::Series {
             label: shape.clone(),
             points: setups
                 .iter()
-                .filter(|(_, per_shape)| !per_shape[k].is_empty())
-                .map(|(_, per_shape)| {
+                .filter(|(_, _, per_shape)| !per_shape[k].is_empty())
+                .map(|(_, _, per_shape)| {
                     let runs = &per_shape[k];
                     let (n, std) = mean_std(&runs.iter().map(|r| r.1).collect::<Vec<_>>());
                     (mean_std(&runs.iter().map(|r| r.0).collect::<Vec<_>>()).0, n, std)
@@ -454,6 +530,18 @@ fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), R
                 .collect(),
         })
         .collect();
+    if let Some(equation) = &equation {
+        series.push(plots::Series {
+            label: format!("{equation} (paper's fit, meshes)"),
+            points: setups
+                .iter()
+                .zip(&predicted)
+                .filter_map(|((_, forms, _), p)| {
+                    Some((mean_std(&forms.iter().map(|f| f.0).collect::<Vec<_>>()).0, (*p)?, 0.0))
+                })
+                .collect(),
+        });
+    }
     blocks.push(Block::Figure {
         file: "shapes".into(),
         caption: "Porosity against the inverse equancy L/S per grain shape (like Fig. 10); bars are ± one standard deviation over the seeds.".into(),
@@ -981,6 +1069,7 @@ mod tests {
             profile: vec![],
             parameters: BTreeMap::new(),
             grain_statistics: BTreeMap::new(),
+            size_case: None,
             experiment: None,
             fluid: None,
             imbrication: None,

@@ -3,13 +3,16 @@
 use analysis::report::write_report;
 use analysis::selection::SelectionOptions;
 use analysis::{JobRecord, analyse};
-use anyhow::bail;
+use std::collections::HashMap;
+
+use anyhow::{Context, bail};
 use store::Store;
 
 use crate::cli::ReportArgs;
 use crate::commands::campaign::{catch_up, open_existing, runtime};
 use crate::outln;
 use crate::records::{campaign_summary, job_record};
+use crate::stored;
 
 pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
     if !(args.threshold > 0.0 && args.threshold <= 1.0) {
@@ -18,13 +21,27 @@ pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
     if args.folds < 2 {
         bail!("--folds = {} is out of range: cross-validation needs at least 2 folds", args.folds);
     }
-    let (status, rows) = runtime()?.block_on(async {
+    let (status, rows, jobs) = runtime()?.block_on(async {
         let store: Store = open_existing(&args.db).await?;
         catch_up(&store, &args.db, &args.name).await?;
-        Ok::<_, anyhow::Error>((store.status(&args.name).await?, store.export(&args.name).await?))
+        Ok::<_, anyhow::Error>((
+            store.status(&args.name).await?,
+            store.export(&args.name).await?,
+            store.jobs(&args.name).await?,
+        ))
     })?;
-    let records: Vec<JobRecord> =
-        rows.iter().filter_map(|row| job_record(row).transpose()).collect::<Result<_, _>>()?;
+    // The size case of each job, for the paper's models of that case.
+    let size_cases = jobs
+        .iter()
+        .map(|job| {
+            let spec = stored::decode(job.format, &job.spec).with_context(|| format!("job {}", job.id))?;
+            Ok((job.id.clone(), spec.packing.grains.size.case().map(|c| c.name)))
+        })
+        .collect::<anyhow::Result<HashMap<_, _>>>()?;
+    let records: Vec<JobRecord> = rows
+        .iter()
+        .filter_map(|row| job_record(row, size_cases.get(&row.job_id).copied().flatten()).transpose())
+        .collect::<Result<_, _>>()?;
     let options = SelectionOptions { threshold: args.threshold, folds: args.folds, seed: args.seed };
     let analysis = analyse(&records, &args.name, &options)?;
     let files = write_report(&campaign_summary(&status), &records, &analysis, &args.out)?;
