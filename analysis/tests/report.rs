@@ -394,6 +394,12 @@ fn single_forms_of_a_paper_case_are_compared_with_its_single_form_model() {
     let svg = check_html(out.path(), 3);
     assert!(svg.contains("Eq. 17 (paper&apos;s fit, meshes)") || svg.contains("Eq. 17 (paper's fit, meshes)"), "{svg}");
 
+    // One form alone: the counts are singular. Ellipsoids 0.362 − 0.3251875, meshes 0.351 − 0.3251875.
+    let one: Vec<JobRecord> = shape_records(Some("U1")).into_iter().filter(|r| r.job_id.contains("-0.8-")).collect();
+    let md = std::fs::read_to_string(report("one-form", &one, out.path()).markdown).unwrap();
+    assert!(md.contains("RMS difference `mesh` − `ellipsoid` over 1 setup: 0.0110."), "{md}");
+    assert!(md.contains("`mesh` +0.0258 on average, mean absolute difference 0.0258 (1 setup)."), "{md}");
+
     // Grains of two cases, or drawn from a form distribution, have no one single-form model.
     let mut mixed = shape_records(Some("U1"));
     mixed[0].size_case = Some("U7".into());

@@ -342,10 +342,15 @@ fn experiment_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
         rows,
     });
     blocks.push(Block::Paragraph(format!(
-        "Mean absolute difference over the {} setups: {:.4}.",
-        differences.len(),
+        "Mean absolute difference over {}: {:.4}.",
+        setup_count(differences.len()),
         differences.iter().sum::<f64>() / differences.len() as f64
     )));
+}
+
+/// "1 setup", "2 setups".
+fn setup_count(n: usize) -> String {
+    format!("{n} setup{}", if n == 1 { "" } else { "s" })
 }
 
 /// Mean and population standard deviation.
@@ -490,10 +495,10 @@ fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), R
     blocks.push(Block::Table { header, rows });
     for (k, sq) in squares.iter().enumerate().filter(|(_, sq)| !sq.is_empty()) {
         blocks.push(Block::Paragraph(format!(
-            "RMS difference `{}` − `{}` over {} setups: {:.4}.",
+            "RMS difference `{}` − `{}` over {}: {:.4}.",
             shapes[k],
             shapes[0],
-            sq.len(),
+            setup_count(sq.len()),
             (sq.iter().sum::<f64>() / sq.len() as f64).sqrt()
         )));
     }
@@ -505,10 +510,10 @@ fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), R
             .map(|(shape, d)| {
                 let n = d.len() as f64;
                 format!(
-                    "`{shape}` {:+.4} on average, mean absolute difference {:.4} ({} setups)",
+                    "`{shape}` {:+.4} on average, mean absolute difference {:.4} ({})",
                     d.iter().sum::<f64>() / n,
                     d.iter().map(|x| x.abs()).sum::<f64>() / n,
-                    d.len()
+                    setup_count(d.len())
                 )
             })
             .collect();
