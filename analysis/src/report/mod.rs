@@ -416,14 +416,19 @@ fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), R
         setups[at].1.push((inv_eq, inv_el));
         setups[at].2[k].push((inv_eq, r.porosity));
     }
-    // The paper's model at each setup's mean form.
-    let predicted: Vec<Option<f64>> = setups
+    // Each setup's mean (L/S, L/I) over all its runs, and the paper's model there.
+    let form_means: Vec<(f64, f64)> = setups
         .iter()
         .map(|(_, forms, _)| {
-            let model = paper.as_ref()?;
-            let mean = |f: fn(&(f64, f64)) -> f64| forms.iter().map(f).sum::<f64>() / forms.len() as f64;
-            let values = BTreeMap::from([("inv_EQ".to_string(), mean(|f| f.0)), ("inv_EL".to_string(), mean(|f| f.1))]);
-            model.predict(&values).ok()
+            let n = forms.len() as f64;
+            (forms.iter().map(|f| f.0).sum::<f64>() / n, forms.iter().map(|f| f.1).sum::<f64>() / n)
+        })
+        .collect();
+    let predicted: Vec<Option<f64>> = form_means
+        .iter()
+        .map(|&(inv_eq, inv_el)| {
+            let values = BTreeMap::from([("inv_EQ".to_string(), inv_eq), ("inv_EL".to_string(), inv_el)]);
+            paper.as_ref()?.predict(&values).ok()
         })
         .collect();
     let equation =
@@ -461,10 +466,10 @@ fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), R
     let mut from_paper = vec![Vec::new(); shapes.len()];
     let rows = setups
         .iter()
-        .zip(&predicted)
-        .map(|((label, forms, per_shape), predicted)| {
+        .zip(form_means.iter().zip(&predicted))
+        .map(|((label, _, per_shape), (&(inv_eq, _), predicted))| {
             let mut row = vec![if label.is_empty() { "all jobs".into() } else { label.clone() }];
-            row.push(format!("{:.2}", mean_std(&forms.iter().map(|f| f.0).collect::<Vec<_>>()).0));
+            row.push(format!("{inv_eq:.2}"));
             if paper.is_some() {
                 row.push(predicted.map_or("–".into(), |p| format!("{p:.3}")));
             }
@@ -538,12 +543,10 @@ fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), R
     if let Some(equation) = &equation {
         series.push(plots::Series {
             label: format!("{equation} (paper's fit, meshes)"),
-            points: setups
+            points: form_means
                 .iter()
                 .zip(&predicted)
-                .filter_map(|((_, forms, _), p)| {
-                    Some((mean_std(&forms.iter().map(|f| f.0).collect::<Vec<_>>()).0, (*p)?, 0.0))
-                })
+                .filter_map(|(&(inv_eq, _), p)| Some((inv_eq, (*p)?, 0.0)))
                 .collect(),
         });
     }
