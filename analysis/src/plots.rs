@@ -201,6 +201,8 @@ pub fn scatter(plot: &ScatterPlot) -> Result<String, PlotError> {
 pub struct Series {
     pub label: String,
     pub points: Vec<(f64, f64, f64)>,
+    /// A model's curve rather than measurements: drawn dashed, without markers.
+    pub model: bool,
 }
 
 /// Series of means joined in order of x, each point with a bar of ± one standard deviation
@@ -227,6 +229,14 @@ pub fn series_with_spread(title: &str, x_label: &str, y_label: &str, series: &[S
             };
             let mut points = s.points.clone();
             points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            if s.model {
+                let line = points.iter().map(|p| (p.0, p.1));
+                chart
+                    .draw_series(DashedLineSeries::new(line, 6, 4, colour.stroke_width(2)))?
+                    .label(s.label.as_str())
+                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], colour.stroke_width(2)));
+                continue;
+            }
             chart.draw_series(LineSeries::new(points.iter().map(|p| (p.0, p.1)), colour.stroke_width(1)))?;
             chart.draw_series(
                 points
@@ -371,6 +381,25 @@ mod tests {
         assert_eq!(decimals((0.34, 0.47)), 2);
         assert_eq!(decimals((0.0, 0.03)), 3);
         assert_eq!(decimals((100.0, 900.0)), 0);
+    }
+
+    #[test]
+    fn a_model_series_is_a_dashed_line_without_markers() {
+        let series = |model| Series { label: "s".into(), points: vec![(1.0, 0.3, 0.01), (2.0, 0.4, 0.0)], model };
+        let measured = series_with_spread("t", "x", "y", &[series(false)]).unwrap();
+        let model = series_with_spread("t", "x", "y", &[series(true)]).unwrap();
+        // The first series' colour, as the SVG writes it.
+        let (stroke, fill) = ("stroke=\"#285AAA\"", "fill=\"#285AAA\"");
+        let elements = |svg: &str, tag: &str, attribute: &str| {
+            svg.split('<').filter(|e| e.starts_with(tag) && e.contains(attribute)).count()
+        };
+        // Markers: one filled circle per point and one in the legend.
+        assert_eq!(elements(&measured, "circle", fill), 3, "{measured}");
+        assert_eq!(elements(&model, "circle", fill), 0, "{model}");
+        // The line joining the points: one polyline, or a dash every 10 px of the ~550 px between
+        // the two points.
+        assert_eq!(elements(&measured, "polyline", stroke), 1, "{measured}");
+        assert!(elements(&model, "polyline", stroke) > 30, "{model}");
     }
 
     #[test]

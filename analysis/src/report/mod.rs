@@ -538,6 +538,7 @@ fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), R
                     (mean_std(&runs.iter().map(|r| r.0).collect::<Vec<_>>()).0, n, std)
                 })
                 .collect(),
+            model: false,
         })
         .collect();
     if let Some(equation) = &equation {
@@ -548,6 +549,7 @@ fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), R
                 .zip(&predicted)
                 .filter_map(|(&(inv_eq, _), p)| Some((inv_eq, (*p)?, 0.0)))
                 .collect(),
+            model: true,
         });
     }
     blocks.push(Block::Figure {
