@@ -158,10 +158,8 @@ pub struct RunArgs {
     pub campaign: PathBuf,
     #[arg(long, default_value = DEFAULT_DB)]
     pub db: PathBuf,
-    /// Packings run at the same time (default: the number of cores); the cores are divided
-    /// among them.
-    #[arg(long)]
-    pub workers: Option<usize>,
+    #[command(flatten)]
+    pub local: LocalArgs,
     #[command(flatten)]
     pub executor: ExecutorArgs,
     #[command(flatten)]
@@ -219,10 +217,23 @@ pub struct ResumeArgs {
     pub name: String,
     #[arg(long, default_value = DEFAULT_DB)]
     pub db: PathBuf,
-    #[arg(long)]
-    pub workers: Option<usize>,
+    #[command(flatten)]
+    pub local: LocalArgs,
     #[command(flatten)]
     pub common: ContinueArgs,
+}
+
+/// How the local executor uses this machine's cores (`run` and `resume`).
+#[derive(Debug, Args)]
+pub struct LocalArgs {
+    /// Packings run at the same time (default: the number of cores); the cores are divided
+    /// among them.
+    #[arg(long)]
+    pub workers: Option<usize>,
+    /// Threads of each packing (default: the cores divided among the workers, at least 1); with
+    /// two campaigns side by side, `--workers 1 --threads 1` each keeps them off each other's core.
+    #[arg(long)]
+    pub threads: Option<usize>,
 }
 
 #[derive(Debug, Args)]
@@ -285,6 +296,9 @@ pub struct PackArgs {
     /// Print result.json to standard output instead of a table (no progress display).
     #[arg(long)]
     pub json: bool,
+    /// Threads of the packing (default: the number of cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
 }
 
 #[derive(Debug, Args)]

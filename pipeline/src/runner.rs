@@ -38,6 +38,8 @@ const CHECKPOINT_FORMAT: u32 = 6;
 #[derive(Debug, Clone)]
 pub struct RunOptions {
     pub workers: usize,
+    /// Threads of each worker's packing.
+    pub threads: usize,
     /// Wall time between checkpoints of a running packing.
     pub checkpoint_interval: Duration,
     /// Start over the jobs whose checkpoints another version of sedpack wrote; without it such
@@ -193,8 +195,6 @@ pub async fn run(store: &Store, campaign: &str, options: &RunOptions, interactiv
     total.set_prefix(campaign.to_string());
     total.set_position(status.done + status.failed);
 
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let per_worker = (threads / options.workers).max(1);
     let mut handles = Vec::new();
     for k in 0..options.workers {
         let bar = bars.add(ProgressBar::new_spinner());
@@ -204,7 +204,7 @@ pub async fn run(store: &Store, campaign: &str, options: &RunOptions, interactiv
             store: store.clone(),
             campaign: campaign.to_string(),
             id: worker_id(k),
-            threads: per_worker,
+            threads: options.threads,
             checkpoint_interval: options.checkpoint_interval,
             discard_old_checkpoints: options.discard_old_checkpoints,
             cancel: cancel.clone(),
@@ -291,7 +291,7 @@ impl Worker {
     ) -> anyhow::Result<()> {
         let label: Vec<String> = claimed.parameters.iter().map(|(k, v)| format!("{k}={v}")).collect();
         let label = format!("{} ({})", claimed.id.get(..8).unwrap_or(&claimed.id), label.join(", "));
-        info!(job = %claimed.id, worker = %self.id, attempt = claimed.attempts, "started");
+        info!(job = %claimed.id, worker = %self.id, attempt = claimed.attempts, threads = self.threads, "started");
         let outcome = match read_spec(claimed.format, &claimed.spec) {
             Ok(spec) => self.execute(&claimed.id, spec, &label, pool).await?,
             Err(e) => Outcome::Failed(format!("{e:#}")),

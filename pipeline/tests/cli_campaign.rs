@@ -48,8 +48,12 @@ fn a_grid_campaign_runs_once_and_reports() {
     assert_eq!(porosities(db, "grid"), before);
     // Adding a grid value adds only the new jobs.
     let wider = write(dir.path(), "grid.yaml", &campaign("grid", 0.05).replace("[0.0, 0.5]", "[0.0, 0.5, 0.3]"));
-    let third = ok(&["run", &wider, "--db", db, "--quiet"]);
+    let third = ok(&["run", &wider, "--db", db, "--quiet", "--workers", "1", "--threads", "3"]);
     assert!(third.contains("6 job(s), 2 new") && third.contains("2 job(s) finished now"), "{third}");
+    let log = std::fs::read_to_string(dir.path().join("sedpack.log")).unwrap();
+    let started: Vec<&str> = log.lines().filter(|l| l.contains(" started ")).collect();
+    assert_eq!(started.len(), 6, "{log}");
+    assert!(started[4..].iter().all(|l| l.contains("threads=3")), "--threads 3 is what the packings ran on: {log}");
 
     let csv = ok(&["export", "grid", "--db", db, "--format", "csv"]);
     let mut lines = csv.lines();
@@ -267,7 +271,11 @@ fn bad_campaigns_and_databases_are_refused_clearly() {
         &["local.yaml:4", "executor.max_parallel", "applies to the slurm executor only"],
     );
     let slurm = executor("slurm.yaml", "  kind: slurm\n");
-    fails(&["run", &slurm, "--db", db, "--workers", "2"], &["--workers applies to the local executor"]);
+    fails(&["run", &slurm, "--db", db, "--workers", "2"], &["--workers and --threads apply to the local executor"]);
+    fails(&["run", &slurm, "--db", db, "--threads", "2"], &["--workers and --threads apply to the local executor"]);
+    let valid = write(dir.path(), "valid.yaml", "name: valid\n");
+    fails(&["run", &valid, "--db", db, "--threads", "0"], &["--threads must be at least 1"]);
+    fails(&["status", "valid", "--db", db], &["valid"]);
     let job = executor("job.yaml", "  kind: slurm\n");
     fails(&["pack", &job], &["job.yaml:2", "executor: is a campaign key"]);
 

@@ -33,8 +33,12 @@ async fn a_failing_worker_stops_the_others_and_every_job_returns_to_pending() {
     sqlx::query("DROP TABLE grain_statistics").execute(&mut raw).await.unwrap();
     raw.close().await.unwrap();
 
-    let options =
-        RunOptions { workers: 2, checkpoint_interval: Duration::from_secs(300), discard_old_checkpoints: false };
+    let options = RunOptions {
+        workers: 2,
+        threads: 1,
+        checkpoint_interval: Duration::from_secs(300),
+        discard_old_checkpoints: false,
+    };
     let error = run(&store, &campaign.name, &options, false).await.unwrap_err();
     let error = format!("{error:#}");
     assert!(error.contains("grain_statistics"), "{error}");
@@ -62,8 +66,12 @@ async fn a_checkpoint_of_another_version_stops_the_run_untouched_unless_discardi
     assert!(store.release(&claimed.id, "old-sedpack").await.unwrap());
 
     // The worker that claims it stops the run instead of starting the packing over.
-    let options =
-        RunOptions { workers: 1, checkpoint_interval: Duration::from_secs(300), discard_old_checkpoints: false };
+    let options = RunOptions {
+        workers: 1,
+        threads: 1,
+        checkpoint_interval: Duration::from_secs(300),
+        discard_old_checkpoints: false,
+    };
     let error = format!("{:#}", run(&store, &campaign.name, &options, false).await.unwrap_err());
     let named = format!("{} (format 3, at t = 2.50 s)", claimed.id);
     assert!(error.contains(&named) && error.contains("--discard-old-checkpoints"), "{error}");

@@ -14,7 +14,7 @@ use store::{CampaignStatus, ExportRow, JobState, NewJob, Store, StoreError, Stor
 use tracing::info;
 
 use crate::campaign::{Campaign, read_campaign};
-use crate::cli::{CancelArgs, ContinueArgs, ExportArgs, ResumeArgs, RunArgs, StatusArgs};
+use crate::cli::{CancelArgs, ContinueArgs, ExportArgs, LocalArgs, ResumeArgs, RunArgs, StatusArgs};
 use crate::executor::{Executor, Request};
 use crate::output::{Table, print_json};
 use crate::records::new_job;
@@ -47,12 +47,20 @@ fn start_log(db: &Path) -> anyhow::Result<PathBuf> {
     Ok(path)
 }
 
-fn workers(requested: Option<usize>) -> anyhow::Result<usize> {
-    match requested {
+/// Workers and threads per worker of the local executor on `cores` cores: as asked, else one
+/// worker per core and the cores divided among the workers.
+fn local_threads(local: &LocalArgs, cores: usize) -> anyhow::Result<(usize, usize)> {
+    let workers = match local.workers {
         Some(0) => bail!("--workers must be at least 1"),
-        Some(n) => Ok(n),
-        None => Ok(std::thread::available_parallelism().map_or(1, |n| n.get())),
-    }
+        Some(n) => n,
+        None => cores,
+    };
+    let threads = match local.threads {
+        Some(0) => bail!("--threads must be at least 1"),
+        Some(n) => n,
+        None => (cores / workers).max(1),
+    };
+    Ok((workers, threads))
 }
 
 /// HEAD followed by the jobs per state ("running" named `running`), then the failures.
@@ -103,7 +111,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
             Err(e) => return Err(e.into()),
         };
         let executor = flags.over(campaign.executor.clone()).resolve(previous.as_ref());
-        check_workers(args.workers, &executor)?;
+        check_workers(&args.local, &executor)?;
         store.upsert_campaign(&campaign.name, &campaign.text).await?;
         switch_executor(&store, &campaign.name, previous.as_ref(), &executor).await?;
         let added = add_jobs(&store, &campaign).await?;
@@ -122,14 +130,18 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
                 added.moved
             )?;
         }
-        continue_campaign(&store, &args.db, &campaign.name, &executor, args.workers, &args.common, interval).await
+        continue_campaign(&store, &args.db, &campaign.name, &executor, &args.local, &args.common, interval).await
     })
 }
 
-fn check_workers(workers: Option<usize>, executor: &Executor) -> anyhow::Result<()> {
-    if workers.is_some() && matches!(executor, Executor::Slurm(_)) {
-        bail!("--workers applies to the local executor; a Slurm task runs one packing on --cpus-per-task threads");
+fn check_workers(local: &LocalArgs, executor: &Executor) -> anyhow::Result<()> {
+    if (local.workers.is_some() || local.threads.is_some()) && matches!(executor, Executor::Slurm(_)) {
+        bail!(
+            "--workers and --threads apply to the local executor; a Slurm task runs one packing on --cpus-per-task threads"
+        );
     }
+    // Counts of zero are refused here, before anything is stored.
+    local_threads(local, 1)?;
     Ok(())
 }
 
@@ -203,15 +215,18 @@ async fn continue_campaign(
     db: &Path,
     name: &str,
     executor: &Executor,
-    workers_asked: Option<usize>,
+    local: &LocalArgs,
     common: &ContinueArgs,
     checkpoint_interval: Duration,
 ) -> anyhow::Result<()> {
     let settings = match executor {
         Executor::Slurm(settings) => settings,
         Executor::Local => {
+            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+            let (workers, threads) = local_threads(local, cores)?;
             let options = RunOptions {
-                workers: workers(workers_asked)?,
+                workers,
+                threads,
                 checkpoint_interval,
                 discard_old_checkpoints: common.discard_old_checkpoints,
             };
@@ -275,9 +290,9 @@ pub fn resume(args: &ResumeArgs) -> anyhow::Result<()> {
     runtime()?.block_on(async {
         let store = open_existing(&args.db).await?;
         let executor = Executor::from_stored(store.campaign(&args.name).await?.executor.as_ref())?;
-        check_workers(args.workers, &executor)?;
+        check_workers(&args.local, &executor)?;
         start_log(&args.db)?;
-        continue_campaign(&store, &args.db, &args.name, &executor, args.workers, &args.common, interval).await
+        continue_campaign(&store, &args.db, &args.name, &executor, &args.local, &args.common, interval).await
     })
 }
 
@@ -487,5 +502,18 @@ mod tests {
         assert_eq!(csv_value(Some(&json!("a,b"))), "\"a,b\"");
         assert_eq!(csv_value(Some(&json!({"fl": 0.5, "el": 0.6}))), r#""{""fl"":0.5,""el"":0.6}""#);
         assert_eq!(csv_value(None), "");
+    }
+
+    #[test]
+    fn the_cores_are_divided_among_the_workers_unless_threads_are_given() {
+        let plan = |workers, threads, cores| local_threads(&LocalArgs { workers, threads }, cores).ok();
+        assert_eq!(plan(None, None, 8), Some((8, 1)));
+        assert_eq!(plan(Some(1), None, 8), Some((1, 8)));
+        assert_eq!(plan(Some(3), None, 8), Some((3, 2)), "8 cores for 3 workers: 2 each, none oversubscribed");
+        assert_eq!(plan(Some(4), None, 2), Some((4, 1)), "more workers than cores: still 1 thread each");
+        assert_eq!(plan(Some(1), Some(1), 2), Some((1, 1)), "two campaigns side by side on 2 cores");
+        assert_eq!(plan(None, Some(3), 2), Some((2, 3)), "asked threads are taken as given");
+        assert_eq!(plan(Some(0), None, 2), None);
+        assert_eq!(plan(None, Some(0), 2), None);
     }
 }

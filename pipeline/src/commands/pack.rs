@@ -5,7 +5,7 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use anyhow::Context;
+use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use serde_json::{Map, Value, json};
@@ -40,12 +40,15 @@ struct ResultFile<'a> {
 }
 
 pub fn run(args: &PackArgs) -> anyhow::Result<()> {
+    if args.threads == Some(0) {
+        bail!("--threads must be at least 1");
+    }
     let job = read_job(&args.job)?;
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from(&job.name));
     let mut packing = Packing::new(job.packing.clone()).with_context(|| format!("{}", args.job.display()))?;
     let bar = progress_bar(args.json);
     // Stepping from inside the pool spares every parallel loop a hand-over to the pool.
-    let pool = rayon::ThreadPoolBuilder::new().build()?;
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(args.threads.unwrap_or(0)).build()?;
     pool.install(|| run_to_convergence(&mut packing, &bar, &args.job))?;
     bar.finish_and_clear();
     let result = packing.result().with_context(|| format!("{}", args.job.display()))?;
