@@ -36,6 +36,18 @@ pub struct JobRecord {
     pub fluid: Option<String>,
     /// The long axes' fabric against the flow, for packings that report one.
     pub imbrication: Option<Imbrication>,
+    /// What the packing took.
+    pub cost: Cost,
+}
+
+/// What a packing took: its grains, the time it simulated and the wall time it stepped for.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Cost {
+    pub grains: u64,
+    /// s.
+    pub simulated_time: f64,
+    /// s, summed over the attempts it was resumed in.
+    pub wall_time: f64,
 }
 
 /// The campaign as a whole, for the report header.

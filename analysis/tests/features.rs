@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 
 use analysis::dataset::{Dataset, FeatureKind, is_single_form, mixture_feature_names};
 use analysis::form_factors::{form_feature_names, grain_statistics};
-use analysis::record::JobRecord;
+use analysis::record::{Cost, JobRecord};
 
 fn record(id: &str, porosity: f64, grains: &[(f64, f64)]) -> JobRecord {
     JobRecord {
@@ -18,6 +18,7 @@ fn record(id: &str, porosity: f64, grains: &[(f64, f64)]) -> JobRecord {
         experiment: None,
         fluid: None,
         imbrication: None,
+        cost: Cost::default(),
     }
 }
 

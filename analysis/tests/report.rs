@@ -8,7 +8,7 @@ use analysis::analyse;
 use analysis::dataset::mixture_feature_names;
 use analysis::form_factors::{form_feature_names, grain_statistics};
 use analysis::model::LinearModel;
-use analysis::record::{CampaignSummary, Experiment, JobRecord};
+use analysis::record::{CampaignSummary, Cost, Experiment, JobRecord};
 use analysis::report::{ReportFiles, write_report};
 use analysis::selection::SelectionOptions;
 use rand::{RngExt, SeedableRng};
@@ -74,6 +74,7 @@ fn mixture_campaign() -> Vec<JobRecord> {
                         experiment: None,
                         fluid: None,
                         imbrication: None,
+                        cost: Cost::default(),
                     });
                 }
             }
@@ -161,6 +162,7 @@ fn a_mixture_campaign_report_recovers_the_planted_model() {
     assert!(positions.windows(2).all(|w| w[0] < w[1]), "columns keep the feature order");
     assert_eq!(rows.len(), records.len());
     let md = std::fs::read_to_string(&files.markdown).unwrap();
+    assert!(!md.contains("Runs per setup"), "one run per setup: the packings table says it all");
     for dropped in all.iter().filter(|n| !header.contains(n)) {
         assert!(md.contains(&format!("| `{dropped}` |")), "dropped {dropped} is explained in the report");
     }
@@ -243,6 +245,12 @@ fn validation_campaign() -> Vec<JobRecord> {
                 experiment: Some(experiment),
                 fluid: None,
                 imbrication: None,
+                // Seeds 1–3: 4,000, 4,010, 4,020 grains, 2.9–3.1 s simulated, 1, 2 and 1.5 h.
+                cost: Cost {
+                    grains: 4_000 + 10 * seed as u64,
+                    simulated_time: 2.9 + 0.1 * seed as f64,
+                    wall_time: [3600.0, 7200.0, 5400.0][seed],
+                },
             });
         }
     }
@@ -265,6 +273,16 @@ fn a_single_form_validation_report_has_table_6() {
         md.contains("| grains.size = U3 | 0.367, 0.369, 0.372 | 0.369 ± 0.002 | 0.356 ± 0.003 | 0.013 | 3.75 |"),
         "{md}"
     );
+    // The runs per setup with the mean packing's cost: 4,010 grains, 3.00 s, 1.5 h, the same
+    // for both cases; and each packing's own in the table of packings.
+    let setups = md.find("## Runs per setup").expect(&md);
+    assert!(
+        md[setups..]
+            .contains("| grains.size = U1 | 0.382, 0.381, 0.386 | 0.383 ± 0.002 | 4010 | 3.00 | 1 h 30 min 00 s |"),
+        "{md}"
+    );
+    assert!(md[setups..].contains("| grains.size = U3 | 0.367, 0.369, 0.372 | 0.369 ± 0.002 | 4010 |"), "{md}");
+    assert!(md[..setups].contains("| 0.3860 | 4020 | 3.10 | 1 h 30 min 00 s |"), "U1 seed 3: {md}");
     let (header, rows) = read_csv(&files.dataset);
     assert_eq!(header[2..], form_feature_names()[..], "single-form campaigns get the 26 factors");
     assert_eq!(rows.len(), 6);
@@ -337,6 +355,7 @@ fn shape_records(size_case: Option<&str>) -> Vec<JobRecord> {
                 experiment: None,
                 fluid: None,
                 imbrication: None,
+                cost: Cost::default(),
             });
         }
     }
@@ -434,6 +453,7 @@ fn a_campaign_with_and_without_drag_compares_them_seed_by_seed() {
                 experiment: None,
                 fluid: fluid.map(String::from),
                 imbrication: None,
+                cost: Cost::default(),
             });
         }
     }
@@ -487,6 +507,7 @@ fn the_imbrication_of_each_setup_is_summed_over_its_runs() {
                 experiment: None,
                 fluid: Some(fluid.into()),
                 imbrication: Some(f),
+                cost: Cost::default(),
             });
         }
     }

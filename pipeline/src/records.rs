@@ -4,6 +4,7 @@
 
 use std::collections::BTreeMap;
 
+use analysis::record::Cost;
 use analysis::{CampaignSummary, Experiment, JobRecord};
 use anyhow::Context;
 use serde::{Deserialize, Serialize};
@@ -143,6 +144,7 @@ pub fn job_record(row: &ExportRow, size_case: Option<&str>) -> anyhow::Result<Op
         experiment: row.experiment_porosity.map(|porosity| Experiment { porosity, std: row.experiment_std }),
         fluid: fluid.map(|f| f.describe()),
         imbrication,
+        cost: Cost { grains: result.particles, simulated_time: result.simulated_time, wall_time: result.wall_time },
     }))
 }
 

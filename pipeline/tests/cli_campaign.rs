@@ -315,6 +315,13 @@ fn a_report_of_single_forms_of_u1_sets_them_beside_eq_17() {
         if name == "u1-shapes" {
             assert!(row.starts_with("| all jobs | 2.78 | 0.354 |"), "{row}");
             assert!(md.contains("Against Eq. 17: `ellipsoid`"), "{md}");
+            // Each packing's row ends with its grains, simulated time and wall time, as stored.
+            for r in rows(db, name) {
+                let result = r.result.unwrap();
+                let cells = format!("| {} | {:.2} |", result.particles, result.simulated_time);
+                let packing = md.lines().find(|l| l.starts_with(&format!("| `{}", &r.job_id[..8]))).expect(&md);
+                assert!(result.particles > 0 && packing.contains(&cells), "{cells} in {packing}");
+            }
         } else {
             assert!(!md.contains("Eq. 17"), "{md}");
         }

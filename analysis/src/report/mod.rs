@@ -21,7 +21,7 @@ use crate::form_factors::symbol;
 use crate::model::LinearModel;
 use crate::paper::paper_model;
 use crate::plots::{self, PlotError, ScatterPlot, ZinggPacking};
-use crate::record::{CampaignSummary, Experiment, JobRecord};
+use crate::record::{CampaignSummary, Cost, Experiment, JobRecord};
 use crate::selection::{Candidate, Selection, SelectionOptions, set_label};
 use document::Block;
 
@@ -59,6 +59,7 @@ pub fn write_report(
     let mut blocks = Vec::new();
     campaign_section(&mut blocks, summary, records, dataset);
     packings_section(&mut blocks, records)?;
+    setups_section(&mut blocks, records);
     experiment_section(&mut blocks, records);
     shape_section(&mut blocks, records)?;
     fluid_section(&mut blocks, records);
@@ -242,7 +243,9 @@ fn packings_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<()
     let varied = varied_parameters(records);
     let mut header: Vec<String> = vec!["job".into()];
     header.extend(varied.iter().map(|(k, _)| format!("`{k}`")));
-    header.extend(["μ_FL", "σ_FL", "μ_EL", "σ_EL", "porosity n"].map(String::from));
+    header.extend(
+        ["μ_FL", "σ_FL", "μ_EL", "σ_EL", "porosity n", "grains", "simulated time (s)", "wall time"].map(String::from),
+    );
     let stat = |r: &JobRecord, key: &str, std: bool| {
         r.grain_statistics.get(key).map_or("–".to_string(), |&(m, s)| format!("{:.3}", if std { s } else { m }))
     };
@@ -255,11 +258,12 @@ fn packings_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<()
             row.extend(varied.iter().map(|(k, _)| r.parameters.get(k).map_or("–".into(), value_text)));
             row.extend([stat(r, "FL", false), stat(r, "FL", true), stat(r, "EL", false), stat(r, "EL", true)]);
             row.push(format!("{:.4}", r.porosity));
+            row.extend(cost_cells(&r.cost));
             row
         })
         .collect();
     blocks.push(Block::Paragraph(
-        "Number-based mean μ and standard deviation σ of flatness FL = S/I and elongation EL = I/L over each packing's grains, and the packing's bulk porosity (§4.4).".into(),
+        "Number-based mean μ and standard deviation σ of flatness FL = S/I and elongation EL = I/L over each packing's grains, the packing's bulk porosity (§4.4), its grains, the time it simulated and the wall time it stepped for (summed over the runs it was resumed in).".into(),
     ));
     blocks.push(Block::Table { header, rows });
     let zingg: Vec<ZinggPacking> = records
@@ -289,18 +293,73 @@ fn packings_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<()
     Ok(())
 }
 
+/// Grains, simulated time and wall time of a packing or of the mean packing of a setup.
+fn cost_cells(cost: &Cost) -> [String; 3] {
+    [cost.grains.to_string(), format!("{:.2}", cost.simulated_time), duration(cost.wall_time)]
+}
+
+/// A packing's setup: its parameters apart from the seed.
+fn setup_label(r: &JobRecord) -> String {
+    let setup: Vec<String> = r
+        .parameters
+        .iter()
+        .filter(|(k, _)| k.as_str() != "seed")
+        .map(|(k, v)| format!("{k} = {}", value_text(v)))
+        .collect();
+    if setup.is_empty() { "all jobs".to_string() } else { setup.join(", ") }
+}
+
+/// The runs of each setup over the seeds, as the paper's tables give them (Tables 6, 7, 11),
+/// where some setup has more than one.
+fn setups_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
+    let mut groups: Vec<(String, Vec<&JobRecord>)> = Vec::new();
+    for r in records {
+        let label = setup_label(r);
+        match groups.iter_mut().find(|g| g.0 == label) {
+            Some(g) => g.1.push(r),
+            None => groups.push((label, vec![r])),
+        }
+    }
+    if groups.iter().all(|g| g.1.len() < 2) {
+        return;
+    }
+    blocks.push(Block::Heading("Runs per setup".into()));
+    blocks.push(Block::Paragraph(
+        "The runs of each setup (differing only in seed): their porosities, mean and standard deviation (population, as the paper's tables give it), and the mean packing's grains, simulated time and wall time.".into(),
+    ));
+    let rows = groups
+        .iter()
+        .map(|(label, runs)| {
+            let mean = |f: &dyn Fn(&JobRecord) -> f64| runs.iter().map(|r| f(r)).sum::<f64>() / runs.len() as f64;
+            let (n, std) = mean_std(&runs.iter().map(|r| r.porosity).collect::<Vec<_>>());
+            let typical = Cost {
+                grains: mean(&|r| r.cost.grains as f64).round() as u64,
+                simulated_time: mean(&|r| r.cost.simulated_time),
+                wall_time: mean(&|r| r.cost.wall_time),
+            };
+            let mut row = vec![
+                label.clone(),
+                runs.iter().map(|r| format!("{:.3}", r.porosity)).collect::<Vec<_>>().join(", "),
+                format!("{n:.3} ± {std:.3}"),
+            ];
+            row.extend(cost_cells(&typical));
+            row
+        })
+        .collect();
+    blocks.push(Block::Table {
+        header: ["setup", "runs", "porosity n (mean ± std)", "grains", "simulated time (s)", "wall time"]
+            .map(String::from)
+            .to_vec(),
+        rows,
+    });
+}
+
 /// Table 6: runs of the same setup (parameters apart from the seed) against the measurement.
 fn experiment_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
     let mut groups: Vec<(String, Vec<f64>, Experiment)> = Vec::new();
     for r in records {
         let Some(experiment) = r.experiment else { continue };
-        let setup: Vec<String> = r
-            .parameters
-            .iter()
-            .filter(|(k, _)| k.as_str() != "seed")
-            .map(|(k, v)| format!("{k} = {}", value_text(v)))
-            .collect();
-        let label = if setup.is_empty() { "all jobs".to_string() } else { setup.join(", ") };
+        let label = setup_label(r);
         match groups.iter_mut().find(|g| g.0 == label && g.2 == experiment) {
             Some(g) => g.1.push(r.porosity),
             None => groups.push((label, vec![r.porosity], experiment)),
@@ -1083,6 +1142,7 @@ mod tests {
             experiment: None,
             fluid: None,
             imbrication: None,
+            cost: Cost::default(),
         };
         let records = [record("0123456789abcdef"), record("0123456789abXdef"), record("short")];
         assert_eq!(short_ids(&records), ["0123456789abc", "0123456789abX", "short"]);
