@@ -179,8 +179,20 @@ fn a_killed_runner_resumes_from_its_checkpoint_with_identical_results() {
     }
     child.kill().unwrap();
     child.wait().unwrap();
-    let running = rows(db, "killed").iter().filter(|r| r.state == JobState::Running).count();
-    assert_eq!(running, 1, "the killed runner left its job running");
+    let running: Vec<String> =
+        rows(db, "killed").into_iter().filter(|r| r.state == JobState::Running).map(|r| r.job_id).collect();
+    assert_eq!(running.len(), 1, "the killed runner left its job running");
+    // `status` says where that job stands: running, with the checkpoint it will resume from.
+    let in_progress = &json(&["status", "killed", "--db", db, "--json"])["in_progress"];
+    assert_eq!(in_progress.as_array().map(|a| a.len()), Some(1), "{in_progress}");
+    assert_eq!(
+        (in_progress[0]["job_id"].as_str(), in_progress[0]["state"].as_str()),
+        (Some(&*running[0]), Some("running"))
+    );
+    let simulated = in_progress[0]["checkpoint"][0].as_f64().expect("a checkpoint");
+    assert!(simulated > 0.0, "{in_progress}");
+    let text = ok(&["status", "killed", "--db", db]);
+    assert!(text.contains(&format!("checkpoint at {simulated:.2} s simulated")), "{text}");
 
     let resumed = ok(&["resume", "killed", "--db", db, "--quiet"]);
     assert!(resumed.contains("4 done"), "{resumed}");

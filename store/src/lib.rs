@@ -25,7 +25,7 @@ use sqlx::sqlite::{
 pub use error::StoreError;
 pub use types::{
     Campaign, CampaignStatus, Checkpoint, ClaimedJob, ExportRow, Failure, GrainStatistic, JobResult, JobState, NewJob,
-    RunningJob, StoredJob,
+    Progress, RunningJob, StoredJob,
 };
 
 /// How long a statement waits for another connection's lock before it fails.
@@ -456,7 +456,23 @@ impl Store {
         ) = sqlx::query_as(sql::STATUS_COUNTS).bind(campaign_id).fetch_one(&mut *tx).await.map_err(self.db())?;
         let failures: Vec<(String, u32, String)> =
             sqlx::query_as(sql::FAILURES).bind(campaign_id).fetch_all(&mut *tx).await.map_err(self.db())?;
+        type ProgressRow = (String, String, Option<String>, u32, Option<f64>, Option<f64>, Option<f64>);
+        let in_progress: Vec<ProgressRow> =
+            sqlx::query_as(sql::IN_PROGRESS).bind(campaign_id).fetch_all(&mut *tx).await.map_err(self.db())?;
         tx.commit().await.map_err(self.db())?;
+        let in_progress = in_progress
+            .into_iter()
+            .map(|(job_id, state, worker_id, attempts, started_at, simulated_time, written_at)| {
+                Ok(Progress {
+                    state: self.state(&job_id, &state)?,
+                    job_id,
+                    worker_id,
+                    attempts,
+                    started_at,
+                    checkpoint: simulated_time.zip(written_at),
+                })
+            })
+            .collect::<Result<_, StoreError>>()?;
         Ok(CampaignStatus {
             campaign: campaign.to_string(),
             jobs,
@@ -470,6 +486,7 @@ impl Store {
                 .collect(),
             wall_time_finished,
             mean_wall_time_done,
+            in_progress,
         })
     }
 

@@ -108,6 +108,13 @@ pub const STATUS_COUNTS: &str = "
            TOTAL(COALESCE(results.wall_time, jobs.wall_time)) FILTER (WHERE jobs.state IN ('done', 'failed')),
            AVG(COALESCE(results.wall_time, jobs.wall_time)) FILTER (WHERE jobs.state = 'done')
     FROM jobs LEFT JOIN results ON results.job_id = jobs.id WHERE jobs.campaign_id = ?1";
+pub const IN_PROGRESS: &str = "
+    SELECT jobs.id, jobs.state, jobs.worker_id, jobs.attempts, jobs.started_at,
+           checkpoints.simulated_time, checkpoints.written_at
+    FROM jobs LEFT JOIN checkpoints ON checkpoints.job_id = jobs.id
+    WHERE jobs.campaign_id = ?1
+      AND (jobs.state = 'running' OR (jobs.state = 'pending' AND checkpoints.job_id IS NOT NULL))
+    ORDER BY jobs.rowid";
 pub const FAILURES: &str = "
     SELECT id, attempts, error FROM jobs
     WHERE campaign_id = ?1 AND state = 'failed' ORDER BY rowid";

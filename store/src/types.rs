@@ -153,6 +153,22 @@ pub struct CampaignStatus {
     pub wall_time_finished: f64,
     /// s per done job (its packing time over all attempts), None before the first one is done.
     pub mean_wall_time_done: Option<f64>,
+    /// The running jobs and the pending ones with a checkpoint, in submission order.
+    pub in_progress: Vec<Progress>,
+}
+
+/// How far a running job, or a pending one that stopped with a checkpoint, has come.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Progress {
+    pub job_id: String,
+    pub state: JobState,
+    /// Who runs it (None when pending).
+    pub worker_id: Option<String>,
+    pub attempts: u32,
+    /// Unix time the current attempt started (None when pending).
+    pub started_at: Option<f64>,
+    /// Simulated time (s) and unix time of its last checkpoint in the database, if any.
+    pub checkpoint: Option<(f64, f64)>,
 }
 
 /// One job of an export, with its result and grain statistics if it is done.

@@ -162,6 +162,40 @@ async fn released_jobs_return_to_pending_with_their_checkpoint() {
 }
 
 #[tokio::test]
+async fn status_says_how_far_running_and_interrupted_jobs_are() {
+    let dir = tempfile::tempdir().unwrap();
+    let store = store_with_jobs(&db_path(&dir), 4).await;
+    let a = store.claim(CAMPAIGN, "w1").await.unwrap().unwrap();
+    let b = store.claim(CAMPAIGN, "w2").await.unwrap().unwrap();
+    let c = store.claim(CAMPAIGN, "w3").await.unwrap().unwrap();
+    store.save_checkpoint(&a.id, "w1", b"a", 1.5).await.unwrap();
+    let in_progress = store.status(CAMPAIGN).await.unwrap().in_progress;
+    let seen: Vec<_> = in_progress
+        .iter()
+        .map(|p| (p.job_id.as_str(), p.state, p.worker_id.as_deref(), p.checkpoint.map(|c| c.0)))
+        .collect();
+    assert_eq!(
+        seen,
+        [
+            (a.id.as_str(), JobState::Running, Some("w1"), Some(1.5)),
+            (b.id.as_str(), JobState::Running, Some("w2"), None),
+            (c.id.as_str(), JobState::Running, Some("w3"), None),
+        ],
+        "the fourth job, pending without a checkpoint, is not in progress"
+    );
+    assert!(in_progress.iter().all(|p| p.started_at.is_some() && p.attempts == 1));
+
+    // Stopped with its checkpoint, a job stays in progress as pending; a failed one leaves.
+    store.release(&a.id, "w1").await.unwrap();
+    store.fail(&b.id, "w2", "diverged").await.unwrap();
+    let in_progress = store.status(CAMPAIGN).await.unwrap().in_progress;
+    let seen: Vec<_> = in_progress.iter().map(|p| (p.job_id.as_str(), p.state, p.worker_id.as_deref())).collect();
+    assert_eq!(seen, [(a.id.as_str(), JobState::Pending, None), (c.id.as_str(), JobState::Running, Some("w3"))]);
+    assert_eq!((in_progress[0].started_at, in_progress[0].checkpoint.map(|c| c.0)), (None, Some(1.5)));
+    store.close().await;
+}
+
+#[tokio::test]
 async fn failed_jobs_keep_their_error_until_retried() {
     let dir = tempfile::tempdir().unwrap();
     let store = store_with_jobs(&db_path(&dir), 2).await;

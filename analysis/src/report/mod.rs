@@ -136,7 +136,8 @@ fn sig(x: f64, digits: i32) -> String {
     format!("{x:.*}", (digits - 1 - magnitude).max(0) as usize)
 }
 
-fn duration(seconds: f64) -> String {
+/// "12.3 s", "3 min 05 s", "1 h 02 min 05 s".
+pub fn duration(seconds: f64) -> String {
     if seconds < 60.0 {
         return format!("{seconds:.1} s");
     }

@@ -7,10 +7,11 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use analysis::csv;
+use analysis::report::duration;
 use anyhow::{Context, bail};
 use serde::Serialize;
 use serde_json::{Map, Value};
-use store::{CampaignStatus, ExportRow, JobState, NewJob, Store, StoreError, StoredJob};
+use store::{CampaignStatus, ExportRow, JobState, NewJob, Progress, Store, StoreError, StoredJob};
 use tracing::info;
 
 use crate::campaign::{Campaign, read_campaign};
@@ -392,12 +393,18 @@ pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
                         s.jobs, s.done, s.failed, s.running, s.pending
                     ),
                 )
-                .row("time spent", format!("{:.0} s on finished jobs", s.wall_time_finished));
+                .row("time spent", format!("{} on finished jobs", duration(s.wall_time_finished)));
             if let Some(left) = r.estimated_time_left {
-                table.row("time left", format!("≈ {left:.0} s for one worker"));
+                table.row("time left", format!("≈ {} for one worker", duration(left)));
             }
             for f in &s.failures {
                 table.row(format!("failed {}", f.job_id), f.error.clone());
+            }
+            if r.tasks.is_none() {
+                let now = unix_now();
+                for p in &s.in_progress {
+                    table.row(format!("job {}", p.job_id), progress_text(p, now));
+                }
             }
             if let Some(tasks) = &r.tasks {
                 table.row("executor", r.executor.to_string());
@@ -418,6 +425,26 @@ pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
         }
         Ok(())
     })
+}
+
+fn unix_now() -> f64 {
+    std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0.0, |d| d.as_secs_f64())
+}
+
+/// A local job in progress in words: "running for 32 min 10 s on vm:1:0 (attempt 2); checkpoint
+/// at 1.90 s simulated, 2 min 05 s ago".
+fn progress_text(p: &Progress, now: f64) -> String {
+    let ago = |t: f64| duration((now - t).max(0.0));
+    let checkpoint = match p.checkpoint {
+        Some((simulated, written)) => format!("checkpoint at {simulated:.2} s simulated, {} ago", ago(written)),
+        None => "no checkpoint yet".into(),
+    };
+    match (&p.worker_id, p.started_at) {
+        (Some(worker), Some(started)) => {
+            format!("running for {} on {worker} (attempt {}); {checkpoint}", ago(started), p.attempts)
+        }
+        _ => format!("pending; {checkpoint}: `resume` continues from it"),
+    }
 }
 
 pub fn export(args: &ExportArgs) -> anyhow::Result<()> {
@@ -502,6 +529,29 @@ mod tests {
         assert_eq!(csv_value(Some(&json!("a,b"))), "\"a,b\"");
         assert_eq!(csv_value(Some(&json!({"fl": 0.5, "el": 0.6}))), r#""{""fl"":0.5,""el"":0.6}""#);
         assert_eq!(csv_value(None), "");
+    }
+
+    #[test]
+    fn jobs_in_progress_say_how_long_they_ran_and_where_they_stopped() {
+        let running = Progress {
+            job_id: "a".into(),
+            state: JobState::Running,
+            worker_id: Some("vm:1:0".into()),
+            attempts: 2,
+            started_at: Some(1000.0),
+            checkpoint: Some((1.9, 2800.0)),
+        };
+        assert_eq!(
+            progress_text(&running, 2930.0),
+            "running for 32 min 10 s on vm:1:0 (attempt 2); checkpoint at 1.90 s simulated, 2 min 10 s ago"
+        );
+        let fresh = Progress { checkpoint: None, ..running.clone() };
+        assert!(progress_text(&fresh, 1030.0).ends_with("(attempt 2); no checkpoint yet"));
+        let stopped = Progress { state: JobState::Pending, worker_id: None, started_at: None, ..running };
+        assert_eq!(
+            progress_text(&stopped, 2810.0),
+            "pending; checkpoint at 1.90 s simulated, 10.0 s ago: `resume` continues from it"
+        );
     }
 
     #[test]
