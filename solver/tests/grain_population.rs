@@ -166,7 +166,9 @@ fn pebbles_are_closed_convex_bounded_and_reproducible() {
     let library = pebble_library(12, 3, 300).unwrap();
     let mut flatness = Vec::new();
     for mesh in &library {
-        assert!(mesh.triangles().len() <= 300);
+        // Within the bound, and as close to it as the scans simplified to it (270 and 300
+        // faces): Table 4 has coarser grains pack looser.
+        assert!((270..=300).contains(&mesh.triangles().len()), "{} faces", mesh.triangles().len());
         // Convex: no vertex lies outside any face plane.
         for t in 0..mesh.triangles().len() {
             let [a, b, c] = mesh.triangle(t);
