@@ -14,8 +14,8 @@ use super::simplify::simplify;
 /// One pebble: the hull of a cloud dense enough for more than `max_faces` triangles, simplified
 /// to `max_faces` like a scan (§5.2.1). A hull of just (max_faces + 4)/2 points, the most that
 /// keep within the bound unsimplified, loses the points chipped into a facet's interior and
-/// ends at 170–240 of 300 faces, and Table 4 has grains of ~200 faces pack ~0.005 looser than
-/// of 300.
+/// ends at 170–240 of 300 faces, and Table 4 has coarser meshes pack looser (~0.005 between
+/// ≤ 300 faces and the next coarser column).
 pub fn pebble(seed: u64, max_faces: usize) -> Result<TriMesh, MeshDefect> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let points = 2 * (max_faces.max(8) + 4);
