@@ -288,6 +288,7 @@ fn bad_campaigns_and_databases_are_refused_clearly() {
     let valid = write(dir.path(), "valid.yaml", "name: valid\n");
     fails(&["run", &valid, "--db", db, "--threads", "0"], &["--threads must be at least 1"]);
     fails(&["status", "valid", "--db", db], &["valid"]);
+    fails(&["pack", &valid, "--threads", "0"], &["--threads must be at least 1"]);
     let job = executor("job.yaml", "  kind: slurm\n");
     fails(&["pack", &job], &["job.yaml:2", "executor: is a campaign key"]);
 
