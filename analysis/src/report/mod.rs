@@ -21,7 +21,7 @@ use crate::form_factors::symbol;
 use crate::model::LinearModel;
 use crate::paper::paper_model;
 use crate::plots::{self, PlotError, ScatterPlot, ZinggPacking};
-use crate::record::{CampaignSummary, Cost, Experiment, JobRecord};
+use crate::record::{CampaignSummary, Cost, JobRecord};
 use crate::selection::{Candidate, Selection, SelectionOptions, set_label};
 use document::Block;
 
@@ -313,14 +313,7 @@ fn setup_label(r: &JobRecord) -> String {
 /// The runs of each setup over the seeds, as the paper's tables give them (Tables 6, 7, 11),
 /// where some setup has more than one.
 fn setups_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
-    let mut groups: Vec<(String, Vec<&JobRecord>)> = Vec::new();
-    for r in records {
-        let label = setup_label(r);
-        match groups.iter_mut().find(|g| g.0 == label) {
-            Some(g) => g.1.push(r),
-            None => groups.push((label, vec![r])),
-        }
-    }
+    let groups = grouped(records, |r| Some(setup_label(r)));
     if groups.iter().all(|g| g.1.len() < 2) {
         return;
     }
@@ -357,15 +350,7 @@ fn setups_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
 
 /// Table 6: runs of the same setup (parameters apart from the seed) against the measurement.
 fn experiment_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
-    let mut groups: Vec<(String, Vec<f64>, Experiment)> = Vec::new();
-    for r in records {
-        let Some(experiment) = r.experiment else { continue };
-        let label = setup_label(r);
-        match groups.iter_mut().find(|g| g.0 == label && g.2 == experiment) {
-            Some(g) => g.1.push(r.porosity),
-            None => groups.push((label, vec![r.porosity], experiment)),
-        }
-    }
+    let groups = grouped(records, |r| Some((setup_label(r), r.experiment?)));
     if groups.is_empty() {
         return;
     }
@@ -376,9 +361,10 @@ fn experiment_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
     let mut differences = Vec::new();
     let rows = groups
         .iter()
-        .map(|(label, runs, experiment)| {
+        .map(|((label, experiment), runs)| {
+            let runs: Vec<f64> = runs.iter().map(|r| r.porosity).collect();
             // Population std of the runs, as Table 6 reports it (its U1 row: 0.382, 0.381, 0.386 → ± 0.002).
-            let (mean, std) = mean_std(runs);
+            let (mean, std) = mean_std(&runs);
             let spread = if runs.len() > 1 { format!("{mean:.3} ± {std:.3}") } else { format!("{mean:.3}") };
             let measured = experiment.porosity;
             differences.push((mean - measured).abs());
@@ -406,6 +392,19 @@ fn experiment_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
         setup_count(differences.len()),
         differences.iter().sum::<f64>() / differences.len() as f64
     )));
+}
+
+/// The records grouped by `key` (those without one left out), in the order keys first appear.
+fn grouped<K: PartialEq>(records: &[JobRecord], key: impl Fn(&JobRecord) -> Option<K>) -> Vec<(K, Vec<&JobRecord>)> {
+    let mut groups: Vec<(K, Vec<&JobRecord>)> = Vec::new();
+    for r in records {
+        let Some(k) = key(r) else { continue };
+        match groups.iter_mut().find(|g| g.0 == k) {
+            Some(g) => g.1.push(r),
+            None => groups.push((k, vec![r])),
+        }
+    }
+    groups
 }
 
 /// "1 setup", "2 setups".

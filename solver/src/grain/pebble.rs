@@ -8,15 +8,15 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::form_distribution::RHINE_FORMS;
-use super::mesh::{MeshDefect, TriMesh};
-use super::simplify::simplify;
+use super::mesh::TriMesh;
+use super::simplify::{SimplifyError, simplify};
 
 /// One pebble: the hull of a cloud dense enough for more than `max_faces` triangles, simplified
 /// to `max_faces` like a scan (§5.2.1). A hull of just (max_faces + 4)/2 points, the most that
 /// keep within the bound unsimplified, loses the points chipped into a facet's interior and
 /// ends at 170–240 of 300 faces, and Table 4 has coarser meshes pack looser (~0.005 between
 /// ≤ 300 faces and the next coarser column).
-pub fn pebble(seed: u64, max_faces: usize) -> Result<TriMesh, MeshDefect> {
+pub fn pebble(seed: u64, max_faces: usize) -> Result<TriMesh, SimplifyError> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let points = 2 * (max_faces.max(8) + 4);
     // Pebbles get the realistic own forms of the Rhine gravel (Table 2, Fig. 2).
@@ -52,12 +52,12 @@ pub fn pebble(seed: u64, max_faces: usize) -> Result<TriMesh, MeshDefect> {
             p + 1e-5 * random_direction(&mut rng)
         })
         .collect();
-    let hull = TriMesh::convex_hull(&cloud)?;
-    Ok(simplify(&hull, max_faces.max(4)).map_or(hull, |s| s.mesh))
+    let hull = TriMesh::convex_hull(&cloud).map_err(SimplifyError::Defect)?;
+    Ok(simplify(&hull, max_faces.max(4))?.mesh)
 }
 
 /// `count` pebbles from one seed: pebble k uses seed·1,000,003 + k.
-pub fn pebble_library(count: usize, seed: u64, max_faces: usize) -> Result<Vec<TriMesh>, MeshDefect> {
+pub fn pebble_library(count: usize, seed: u64, max_faces: usize) -> Result<Vec<TriMesh>, SimplifyError> {
     (0..count as u64).map(|k| pebble(seed.wrapping_mul(1_000_003).wrapping_add(k), max_faces)).collect()
 }
 
