@@ -174,7 +174,9 @@ pub async fn run(store: &Store, campaign: &str, options: &RunOptions, interactiv
         let cancel = cancel.clone();
         tokio::spawn(async move {
             if tokio::signal::ctrl_c().await.is_ok() {
-                eprintln!("sedpack: stopping; running jobs return to pending (Ctrl-C again to quit at once)");
+                eprintln!(
+                    "sedpack: stopping; running jobs write a checkpoint and return to pending (Ctrl-C again to quit at once)"
+                );
                 cancel.store(true, Ordering::SeqCst);
                 if tokio::signal::ctrl_c().await.is_ok() {
                     std::process::exit(130);
@@ -282,6 +284,20 @@ impl Worker {
         Ok(summary)
     }
 
+    /// Checkpoints a packing stopped by Ctrl-C (or by another worker's failure), so that `resume`
+    /// loses none of the work done since its last checkpoint.
+    async fn keep(&self, job: &str, packing: &Packing) {
+        let time = packing.simulation.time;
+        let saved = match checkpoint_data(packing) {
+            Ok(data) => self.store.save_checkpoint(job, &self.id, &data, time).await.map_err(anyhow::Error::from),
+            Err(e) => Err(e.into()),
+        };
+        match saved {
+            Ok(()) => info!(job, simulated_time = time, "checkpoint on stopping"),
+            Err(e) => warn!(job, error = %e, "checkpoint on stopping not saved; resume continues from the last one"),
+        }
+    }
+
     /// Runs a claimed job and records how it ended.
     async fn handle(
         &self,
@@ -304,7 +320,10 @@ impl Worker {
                 summary.completed += 1;
                 self.total.inc(1);
             }
-            Outcome::Stopped(_) => {
+            Outcome::Stopped(packing) => {
+                if self.cancel.load(Ordering::SeqCst) {
+                    self.keep(&claimed.id, &packing).await;
+                }
                 if self.store.release(&claimed.id, &self.id).await? {
                     info!(job = %claimed.id, "returned to pending");
                 }

@@ -107,7 +107,7 @@ fn a_saved_model_predicts_what_its_formula_gives() {
 }
 
 #[test]
-fn ctrl_c_returns_running_jobs_to_pending() {
+fn ctrl_c_checkpoints_running_jobs_and_returns_them_to_pending() {
     let dir = tempfile::tempdir().unwrap();
     let file = write(dir.path(), "stop.yaml", &campaign("stop", 0.6));
     let db = &path_in(dir.path(), "stop.db");
@@ -134,6 +134,24 @@ fn ctrl_c_returns_running_jobs_to_pending() {
     let rows = rows(db, "stop");
     assert!(rows.iter().all(|r| r.state != JobState::Running), "no job left running");
     assert!(rows.iter().any(|r| r.state == JobState::Pending), "the interrupted job is pending again");
+    // The default interval (300 s) wrote no checkpoint in these seconds: the one there was
+    // written on stopping, and `resume` continues from it.
+    let in_progress = &json(&["status", "stop", "--db", db, "--json"])["in_progress"];
+    assert_eq!(in_progress.as_array().map(|a| a.len()), Some(1), "{in_progress}");
+    assert_eq!(in_progress[0]["state"].as_str(), Some("pending"), "{in_progress}");
+    let simulated = in_progress[0]["checkpoint"][0].as_f64().expect("a checkpoint written on stopping");
+    assert!(simulated > 0.0, "{in_progress}");
+    let resumed = ok(&["resume", "stop", "--db", db, "--quiet"]);
+    assert!(resumed.contains("4 done"), "{resumed}");
+    let log = std::fs::read_to_string(dir.path().join("stop.log")).unwrap();
+    assert!(log.contains("checkpoint on stopping"), "{log}");
+    let from: f64 = log
+        .lines()
+        .find(|l| l.contains("resuming from a checkpoint"))
+        .and_then(|l| l.split("simulated_time=").nth(1))
+        .and_then(|t| t.split_whitespace().next()?.parse().ok())
+        .unwrap_or_else(|| panic!("no resume from a checkpoint: {log}"));
+    assert!((from - simulated).abs() < 1e-9, "resumed from {from} s, the checkpoint is at {simulated} s");
 }
 
 #[test]
