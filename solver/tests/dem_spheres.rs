@@ -223,13 +223,21 @@ fn unstable_setups_stop_with_a_clear_error() {
         Simulation::new(Domain::Periodic { width: 0.05 }, coarse),
         Err(SolverError::TimeStepTooLarge { .. })
     ));
-    // Two spheres overlapping by 60 % of a radius: the step refuses to go on.
-    let mut sim = Simulation::new(Domain::Periodic { width: 0.05 }, settings(0.1, 0.5, Vector3::zeros())).unwrap();
-    sim.add_body(sphere(3e-3, Vector3::new(0.02, 0.02, 0.02), Vector3::zeros()));
-    sim.add_body(sphere(3e-3, Vector3::new(0.02 + 4.2e-3, 0.02, 0.02), Vector3::zeros()));
-    let error = sim.step().unwrap_err();
-    assert!(matches!(error, SolverError::Overlap { relative, .. } if (relative - 0.6).abs() < 1e-9));
-    assert!(error.to_string().contains("overlap"));
+    // A sphere of radius 1 mm wholly inside one of 5 mm (centres 3.9 mm apart): the overlap,
+    // 1 + 5 − 3.9 = 2.1 mm, is 2.1 of the smaller radius, past its whole diameter, so the step
+    // refuses to go on; 1.9 of it (centres 4.1 mm apart) is a deep contact, not an instability.
+    for (distance, unstable) in [(3.9e-3, true), (4.1e-3, false)] {
+        let mut sim = Simulation::new(Domain::Periodic { width: 0.05 }, settings(0.1, 0.5, Vector3::zeros())).unwrap();
+        sim.add_body(sphere(5e-3, Vector3::new(0.02, 0.02, 0.02), Vector3::zeros()));
+        sim.add_body(sphere(1e-3, Vector3::new(0.02 + distance, 0.02, 0.02), Vector3::zeros()));
+        match sim.step() {
+            Err(error) if unstable => {
+                assert!(matches!(error, SolverError::Overlap { relative, .. } if (relative - 2.1).abs() < 1e-9));
+                assert!(error.to_string().contains("overlap by 2.10 of the smaller one's half-thickness"), "{error}");
+            }
+            result => assert_eq!(result.is_err(), unstable, "{result:?}"),
+        }
+    }
     // A velocity that is not a number is caught at once.
     let mut sim = Simulation::new(Domain::Periodic { width: 0.05 }, settings(0.1, 0.5, Vector3::zeros())).unwrap();
     sim.add_body(sphere(3e-3, Vector3::new(0.02, 0.02, 0.02), Vector3::new(f64::NAN, 0.0, 0.0)));
