@@ -60,6 +60,9 @@ pub struct CampaignSummary {
     pub failed: usize,
     /// Runtimes of the finished jobs added up, s.
     pub total_runtime: f64,
+    /// Finished jobs whose grains were created by a sedpack that dropped the grains finding no
+    /// room on the generation grid (0.1.0), which biased their size and form distributions.
+    pub dropped_grains: usize,
 }
 
 impl CampaignSummary {

@@ -84,7 +84,15 @@ fn mixture_campaign() -> Vec<JobRecord> {
 }
 
 fn summary(name: &str, done: usize) -> CampaignSummary {
-    CampaignSummary { name: name.into(), pending: 0, running: 0, done, failed: 1, total_runtime: 7384.0 }
+    CampaignSummary {
+        name: name.into(),
+        pending: 0,
+        running: 0,
+        done,
+        failed: 1,
+        total_runtime: 7384.0,
+        dropped_grains: 0,
+    }
 }
 
 /// The analysis of the records with the default options, and its report in `out`.

@@ -19,6 +19,9 @@ use crate::stored;
 
 /// A planned job as the store keeps it: the stored spec and, in typed columns, what later
 /// stages read without decoding the spec.
+/// The versions of sedpack whose generation threw away the grains that found no room on the grid.
+const DROPPED_GRAINS: [&str; 1] = ["0.1.0"];
+
 pub fn new_job(job: &PlannedJob) -> NewJob {
     let experiment = job.spec.experiment;
     NewJob {
@@ -149,7 +152,7 @@ pub fn job_record(row: &ExportRow, size_case: Option<&str>) -> anyhow::Result<Op
 }
 
 /// The campaign's counts and time spent, for the report's header.
-pub fn campaign_summary(status: &CampaignStatus) -> CampaignSummary {
+pub fn campaign_summary(status: &CampaignStatus, rows: &[ExportRow]) -> CampaignSummary {
     CampaignSummary {
         name: status.campaign.clone(),
         pending: status.pending as usize,
@@ -157,6 +160,10 @@ pub fn campaign_summary(status: &CampaignStatus) -> CampaignSummary {
         done: status.done as usize,
         failed: status.failed as usize,
         total_runtime: status.wall_time_finished,
+        dropped_grains: rows
+            .iter()
+            .filter(|row| row.result.as_ref().is_some_and(|r| DROPPED_GRAINS.contains(&r.solver_version.as_str())))
+            .count(),
     }
 }
 

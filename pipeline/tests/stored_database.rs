@@ -96,7 +96,10 @@ fn a_database_of_version_0_1_0_resumes_and_reports_the_same_results() {
 
     // The report's dataset holds the stored jobs' numbers; the kept jobs' rows are 0.1.0's.
     let out = dir.path().join("report");
-    ok(&["report", "fixture", "--db", db, "--out", out.to_str().unwrap()]);
+    let report = common::sedpack(&["report", "fixture", "--db", db, "--out", out.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&report.stderr);
+    assert!(report.status.success(), "{stderr}");
+    assert!(stderr.contains("fixture: 3 finished job(s) were packed by sedpack 0.1.0"), "{stderr}");
     let expected = fixture("v0.1.0/expected-report");
     let dataset = read(&out.join("dataset.csv"));
     let want = read(&expected.join("dataset.csv"));
@@ -106,6 +109,8 @@ fn a_database_of_version_0_1_0_resumes_and_reports_the_same_results() {
     }
     // The campaign's measurement (porosity 0.4, no spread) comes from the stored jobs of 0.1.0.
     let md = read(&out.join("report.md"));
+    // The three packings 0.1.0 made are flagged: its generation dropped grains.
+    assert!(md.contains("**Warning:** 3 of the finished jobs were packed by sedpack 0.1.0"), "{md}");
     assert!(md.contains("| grains.form.mu_fl = 0.7 | 0.386 | 0.386 | 0.400 (spread not given) | -0.014 |"), "{md}");
     assert!(!md.contains("± 0.000"), "an unknown spread is not shown as 0: {md}");
 

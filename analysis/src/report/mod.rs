@@ -225,6 +225,15 @@ fn campaign_section(
         rows.push(vec![format!("`{key}`"), values.join(", ")]);
     }
     blocks.push(Block::Table { header: vec!["".into(), "value".into()], rows });
+    if summary.dropped_grains > 0 {
+        blocks.push(Block::Paragraph(format!(
+            "**Warning:** {} of the finished jobs were packed by sedpack 0.1.0, which threw away every grain that \
+             found no room on the generation grid instead of keeping it for the next set. Their packings lack \
+             coarse grains of wide sieve curves (a U7 packing kept none above 16 mm) and elongated grains of form \
+             mixtures, and their porosity is biased; pack them again with this version (a new database).",
+            summary.dropped_grains
+        )));
+    }
     if summary.failed + summary.pending + summary.running > 0 {
         blocks.push(Block::Paragraph(format!(
             "Only the {} finished jobs enter the analysis; {} failed, {} are pending and {} running.",

@@ -44,7 +44,16 @@ pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
         .collect::<Result<_, _>>()?;
     let options = SelectionOptions { threshold: args.threshold, folds: args.folds, seed: args.seed };
     let analysis = analyse(&records, &args.name, &options)?;
-    let files = write_report(&campaign_summary(&status), &records, &analysis, &args.out)?;
+    let summary = campaign_summary(&status, &rows);
+    if summary.dropped_grains > 0 {
+        eprintln!(
+            "sedpack: warning: {}: {} finished job(s) were packed by sedpack 0.1.0, whose generation dropped grains \
+             (coarse ones of wide sieve curves, elongated ones of form mixtures); their porosity is biased: \
+             pack them again with this version, in a new database",
+            args.name, summary.dropped_grains
+        );
+    }
+    let files = write_report(&summary, &records, &analysis, &args.out)?;
     outln!("{}: report of {} finished job(s)", args.name, records.len())?;
     outln!("  {}", files.html.display())?;
     outln!("  {}", files.markdown.display())?;
