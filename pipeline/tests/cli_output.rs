@@ -64,9 +64,12 @@ fn every_printing_command_ends_quietly_when_the_reader_is_gone() {
         vec!["report", "fixture", "--db", db, "--out", report.to_str().unwrap()],
         vec!["--help"],
     ];
+    // The fixture's results are 0.1.0's, of which `report` warns: that line is expected.
+    let warning = "sedpack: warning: fixture: 3 finished job(s) were packed by sedpack 0.1.0";
     for args in &commands {
         let output = with_closed_stdout(args);
         let stderr = String::from_utf8_lossy(&output.stderr);
-        assert!(output.status.success() && stderr.is_empty(), "{args:?}: {:?}, {stderr}", output.status);
+        let unexpected: Vec<&str> = stderr.lines().filter(|l| !l.starts_with(warning)).collect();
+        assert!(output.status.success() && unexpected.is_empty(), "{args:?}: {:?}, {stderr}", output.status);
     }
 }

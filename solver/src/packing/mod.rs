@@ -44,8 +44,9 @@ pub enum PackingError {
     )]
     NoGridPositions { spacing: f64 },
     #[error(
-        "a grain of bounding radius {radius} m fits no position of the generation grid (spacing \
-         {spacing} m) inside the domain: widen the domain or narrow the grains"
+        "a grain of bounding radius {radius} m fits inside the domain at no position of the generation \
+         grid (spacing {spacing} m) in any of {ORIENTATIONS} random orientations: widen the domain or narrow \
+         the grains"
     )]
     NoRoom { radius: f64, spacing: f64 },
     #[error("not converged after solver.max_time = {0} s of simulated time")]
@@ -144,6 +145,10 @@ pub struct Packing {
     /// The spec's fluid forces, handed to the simulation every step (it does not keep them).
     fluid: Option<Fluid>,
 }
+
+/// Random orientations a grain tries before it waits for the next set: in a cylinder, a long
+/// grain near the axis fits when it stands steeply enough.
+const ORIENTATIONS: usize = 32;
 
 /// Steps between checks of whether the last set has left the generation region.
 const GENERATION_CHECK_STEPS: u64 = 100;
@@ -325,19 +330,35 @@ impl Packing {
         self.set_start = self.simulation.bodies.len();
         for (draw, shape) in set {
             let r = shape.bounding_radius();
-            if !self.grid.iter().any(|p| domain.holds(p.x, p.y, r)) {
-                return Err(PackingError::NoRoom { radius: r, spacing: self.derived.spacing });
+            // Free positions where the grain's bounding sphere touches no other, whatever its turn.
+            let clear: Vec<usize> = (0..free.len())
+                .filter(|&k| {
+                    let p = &self.grid[free[k]];
+                    occupied.iter().all(|(q, rq)| domain.nearest_distance2(p, q) >= (r + rq).powi(2))
+                })
+                .collect();
+            let mut placement = None;
+            for _ in 0..ORIENTATIONS {
+                let orientation = uniform_rotation(&mut self.rng);
+                let reach = shape.horizontal_reach(&orientation);
+                if let Some(&k) =
+                    clear.iter().find(|&&k| domain.holds(self.grid[free[k]].x, self.grid[free[k]].y, reach))
+                {
+                    placement = Some((k, orientation));
+                    break;
+                }
+                if clear.is_empty() || domain.is_periodic() {
+                    break;
+                }
             }
-            let fits = |p: &Vector3<f64>| {
-                domain.holds(p.x, p.y, r)
-                    && occupied.iter().all(|(q, rq)| domain.nearest_distance2(p, q) >= (r + rq).powi(2))
-            };
-            let Some(slot) = free.iter().position(|&g| fits(&self.grid[g])) else {
+            let Some((slot, orientation)) = placement else {
+                if self.simulation.bodies.len() == self.set_start {
+                    return Err(PackingError::NoRoom { radius: r, spacing: self.derived.spacing });
+                }
                 self.pending.push(draw);
                 continue;
             };
             let position = self.grid[free.remove(slot)];
-            let orientation = uniform_rotation(&mut self.rng);
             let mut spin = || self.rng.random_range(-0.1..0.1) * u;
             let velocity = Vector3::new(spin(), spin(), -u);
             let angular_velocity = Vector3::new(spin(), spin(), spin()) / draw.record.size;
@@ -435,26 +456,29 @@ mod tests {
     use super::*;
     use crate::grain::Table3Case;
 
-    /// Generates every set of a U7 packing of ellipsoids with the form of the shipped Rhine
-    /// scans (FL 0.65, EL 0.53: a 27 mm grain is 60 mm long, nearly three grid spacings) without
-    /// the dynamics: a placed set is moved far below the generation region, as if it had fallen.
-    /// Checks on the way that no two grains of a set overlap; returns the packing.
-    fn generate_without_falling(kind: DomainKind) -> Packing {
+    /// Generates every set of a U7 packing of ellipsoids of FL 0.65 and EL `el` without the
+    /// dynamics: a placed set is moved far below the generation region, as if it had fallen.
+    /// Checks on the way that no two grains of a set overlap and that every grain lies inside
+    /// the domain; returns the packing and how many grains fit the cylinder only by their turn.
+    fn generate_without_falling(kind: DomainKind, el: f64) -> (Packing, usize) {
         let mut spec = PackingSpec::paper(kind);
         spec.grains.size = Table3Case::find("U7").unwrap().sieve_curve();
-        spec.grains.form = FormSpec::Single { fl: 0.65, el: 0.53 };
+        spec.grains.form = FormSpec::Single { fl: 0.65, el };
         if kind == DomainKind::Periodic {
             (spec.domain, spec.grains.mass) = (crate::dem::Domain::Periodic { width: 0.1 }, 4.0);
         }
         let mut packing = Packing::new(spec).unwrap();
         let domain = packing.spec.domain;
+        let mut turned = 0;
         while packing.created_mass < packing.spec.grains.mass || !packing.pending.is_empty() {
             let start = packing.simulation.bodies.len();
             packing.generate_set().unwrap();
             let b = &mut packing.simulation.bodies;
             assert!(b.len() > start, "a set placed no grain");
             for i in start..b.len() {
-                assert!(domain.holds(b.position[i].x, b.position[i].y, b.bounding_radius[i]));
+                let (x, y) = (b.position[i].x, b.position[i].y);
+                assert!(domain.holds(x, y, b.shape[i].horizontal_reach(&b.orientation[i])));
+                turned += usize::from(!domain.holds(x, y, b.bounding_radius[i]));
                 for j in start..i {
                     let d2 = domain.nearest_distance2(&b.position[i], &b.position[j]);
                     assert!(d2 >= (b.bounding_radius[i] + b.bounding_radius[j]).powi(2), "grains {i} and {j} overlap");
@@ -464,7 +488,7 @@ mod tests {
                 z.z -= 10.0;
             }
         }
-        packing
+        (packing, turned)
     }
 
     /// Every drawn grain is placed, so the grains per sieve class follow the number weights of
@@ -472,10 +496,16 @@ mod tests {
     /// rounding of the rare classes) of N w_i, for any seed. sedpack 0.1.0 threw away the grains
     /// that found no room: its Table 6 U7 packing of the Rhine scans held none of the ~15 grains
     /// above 16 mm expected among its first 2,731 (here: ~24 of ~4,250 and ~19 of ~3,260).
+    /// In the cylinder the grains are longer (EL 0.45: a 31.5 mm grain is 83 mm long), so that
+    /// the coarsest fit the 0.104 m cylinder from the grid positions nearest its axis (15.6 mm
+    /// off it) only standing steeply: its bounding sphere would cross the wall.
     #[test]
     fn generation_keeps_the_drawn_sieve_curve_of_a_wide_distribution() {
-        for kind in [DomainKind::Periodic, DomainKind::Cylinder] {
-            let packing = generate_without_falling(kind);
+        for (kind, el) in [(DomainKind::Periodic, 0.53), (DomainKind::Cylinder, 0.45)] {
+            let (packing, turned) = generate_without_falling(kind, el);
+            if kind == DomainKind::Cylinder {
+                assert!(turned > 0, "no grain needed its turn to fit the cylinder");
+            }
             let weights = packing.spec.grains.size.number_weights();
             let n = packing.grains.len() as f64;
             let mut counts = vec![0usize; weights.len()];
@@ -500,5 +530,21 @@ mod tests {
             assert!(mass >= target && mass < target + heaviest, "{kind:?}: {mass} kg for {target} kg");
             assert_eq!(packing.grains.len(), b.len());
         }
+    }
+
+    /// A grain that no turn fits into the domain is an error naming the grain, not a set that
+    /// waits for it forever: ellipsoids of 0.1–0.11 m with FL = EL = 0.9 need at least I/2 ≥
+    /// 52.6 mm around their centre, more than the 52 mm radius of the 0.104 m cylinder, even on
+    /// its axis (the one position of a grid of spacing 0.1 m).
+    #[test]
+    fn a_grain_too_wide_for_the_cylinder_in_any_turn_is_an_error() {
+        let mut spec = PackingSpec::paper(DomainKind::Cylinder);
+        spec.grains.size = crate::grain::SieveCurve::new(vec![0.1, 0.11], vec![1.0]).unwrap();
+        spec.process.spacing = Some(0.1);
+        spec.grains.form = FormSpec::Single { fl: 0.9, el: 0.9 };
+        let mut packing = Packing::new(spec).unwrap();
+        let error = packing.generate_set().unwrap_err();
+        assert!(matches!(error, PackingError::NoRoom { radius, .. } if radius > 0.052), "{error}");
+        assert!(error.to_string().contains("in any of 32 random orientations"), "{error}");
     }
 }

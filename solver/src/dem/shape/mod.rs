@@ -92,6 +92,32 @@ impl Shape {
         }
     }
 
+    /// Largest horizontal distance of the shape's points from its centre of mass when turned by
+    /// `orientation`: what a grain needs of a cylinder's radius around its centre.
+    pub fn horizontal_reach(&self, orientation: &UnitQuaternion<f64>) -> f64 {
+        let rotation = orientation.to_rotation_matrix().into_inner();
+        let horizontal = |v: Vector3<f64>| v.x.hypot(v.y);
+        match self {
+            Shape::Sphere { radius } => *radius,
+            // The ellipsoid's shadow on the plane is the ellipse of the 2 × 2 upper block of
+            // R diag(a², b², c²) Rᵀ; its largest semi-axis is the root of that block's larger
+            // eigenvalue.
+            Shape::Ellipsoid { semi_axes } => {
+                let m = rotation * Matrix3::from_diagonal(&semi_axes.component_mul(semi_axes)) * rotation.transpose();
+                let (mean, half_gap) =
+                    ((m[(0, 0)] + m[(1, 1)]) / 2.0, ((m[(0, 0)] - m[(1, 1)]) / 2.0).hypot(m[(0, 1)]));
+                (mean + half_gap).sqrt()
+            }
+            Shape::Bonded(b) => {
+                b.spheres.iter().map(|c| horizontal(rotation * c.center) + c.radius).fold(0.0, f64::max)
+            }
+            Shape::Polyhedron(p) => {
+                let map = rotation * Matrix3::from_diagonal(&p.scale);
+                p.base.vertices().iter().map(|v| horizontal(map * v)).fold(0.0, f64::max)
+            }
+        }
+    }
+
     /// L, I, S of the shape: the full axes of a sphere or ellipsoid, the axes a bonded grain was
     /// built for.
     pub fn form(&self) -> FormParameters {
