@@ -228,9 +228,10 @@ fn campaign_section(
     if summary.dropped_grains > 0 {
         blocks.push(Block::Paragraph(format!(
             "**Warning:** {} of the finished jobs were packed by sedpack 0.1.0, which threw away every grain that \
-             found no room on the generation grid instead of keeping it for the next set. Their packings lack \
-             coarse grains of wide sieve curves (a U7 packing kept none above 16 mm) and elongated grains of form \
-             mixtures, and their porosity is biased; pack them again with this version (a new database).",
+             found no room on the generation grid instead of keeping it for the next set. Packings of wide sieve \
+             curves lack most of their coarse grains (a U7 packing kept none above 16 mm) and form mixtures lose \
+             some of their elongated grains, which biases their porosity; packings of one form in one sieve class \
+             are barely affected. Pack the others again with this version (in a new database).",
             summary.dropped_grains
         )));
     }

@@ -47,9 +47,10 @@ pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
     let summary = campaign_summary(&status, &rows);
     if summary.dropped_grains > 0 {
         eprintln!(
-            "sedpack: warning: {}: {} finished job(s) were packed by sedpack 0.1.0, whose generation dropped grains \
-             (coarse ones of wide sieve curves, elongated ones of form mixtures); their porosity is biased: \
-             pack them again with this version, in a new database",
+            "sedpack: warning: {}: {} finished job(s) were packed by sedpack 0.1.0, whose generation dropped the \
+             grains that found no room: wide sieve curves lost most coarse grains and form mixtures some elongated \
+             ones, which biases their porosity (one form in one sieve class is barely affected); pack those again \
+             with this version, in a new database",
             args.name, summary.dropped_grains
         );
     }
