@@ -17,11 +17,11 @@ use store::{CampaignStatus, ExportRow, GrainStatistic, JobResult, NewJob};
 use crate::campaign::PlannedJob;
 use crate::stored;
 
-/// A planned job as the store keeps it: the stored spec and, in typed columns, what later
-/// stages read without decoding the spec.
 /// The versions of sedpack whose generation threw away the grains that found no room on the grid.
 const DROPPED_GRAINS: [&str; 1] = ["0.1.0"];
 
+/// A planned job as the store keeps it: the stored spec and, in typed columns, what later
+/// stages read without decoding the spec.
 pub fn new_job(job: &PlannedJob) -> NewJob {
     let experiment = job.spec.experiment;
     NewJob {
