@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 use anyhow::anyhow;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use solver::packing::{Packing, PackingResult, Phase, Progress};
-use store::{ClaimedJob, JobState, Store};
+use store::{ClaimedJob, JobState, Stage, Store};
 use tokio::sync::mpsc;
 use tracing::{info, warn};
 
@@ -114,7 +114,8 @@ pub struct Summary {
 
 enum Message {
     Progress(solver::packing::Progress),
-    Checkpoint(Vec<u8>, f64),
+    /// A checkpoint and where the packing stood when it was taken.
+    Checkpoint(Vec<u8>, Progress),
     /// Something the user should know, such as a checkpoint that cannot be used.
     Warning(String),
 }
@@ -288,8 +289,11 @@ impl Worker {
     /// loses none of the work done since its last checkpoint.
     async fn keep(&self, job: &str, packing: &Packing) {
         let time = packing.simulation.time;
+        let stage = stage(&packing.progress());
         let saved = match checkpoint_data(packing) {
-            Ok(data) => self.store.save_checkpoint(job, &self.id, &data, time).await.map_err(anyhow::Error::from),
+            Ok(data) => {
+                self.store.save_checkpoint(job, &self.id, &data, time, Some(&stage)).await.map_err(anyhow::Error::from)
+            }
             Err(e) => Err(e.into()),
         };
         match saved {
@@ -365,8 +369,6 @@ impl Worker {
             pool.install(|| simulate(&id, spec, checkpoint.as_ref().map(|c| &c.data[..]), &mut relay, interval))
         });
         let mut heartbeat = tokio::time::interval(HEARTBEAT);
-        // The log says at each checkpoint where the packing stands, for runs without a terminal.
-        let mut last: Option<Progress> = None;
         loop {
             tokio::select! {
                 // Messages first, so that none sent before the packing ended is lost.
@@ -376,20 +378,19 @@ impl Worker {
                         self.bar.set_message(format!(
                             "{label}: {} t = {:.3} s, {} grains, {} contacts", p.phase.name(), p.time, p.grains, p.contacts
                         ));
-                        last = Some(p);
                     }
                     Message::Warning(text) => {
                         warn!(job, "{text}");
                         self.bar.println(format!("sedpack: warning: job {job}: {text}"));
                     }
-                    Message::Checkpoint(data, time) => {
-                        if let Err(e) = self.store.save_checkpoint(job, &self.id, &data, time).await {
+                    Message::Checkpoint(data, p) => {
+                        if let Err(e) = self.store.save_checkpoint(job, &self.id, &data, p.time, Some(&stage(&p))).await {
                             warn!(job, error = %e, "checkpoint not saved; stopping the job");
                             lost.store(true, Ordering::SeqCst);
-                        } else if let Some(p) = &last {
+                        } else {
                             info!(
                                 job,
-                                simulated_time = time,
+                                simulated_time = p.time,
                                 phase = p.phase.name(),
                                 grains = p.grains,
                                 mass_created = format!("{:.1} %", 100.0 * p.created),
@@ -397,8 +398,6 @@ impl Worker {
                                 bytes = data.len(),
                                 "checkpoint"
                             );
-                        } else {
-                            info!(job, simulated_time = time, bytes = data.len(), "checkpoint");
                         }
                     }
                 },
@@ -420,8 +419,8 @@ impl Worker {
 /// Where a packing loop reports to, and learns whether to stop.
 pub(crate) trait Observer {
     fn progress(&mut self, progress: Progress);
-    /// Keeps a checkpoint; false when it cannot, and the packing stops.
-    fn checkpoint(&mut self, data: Vec<u8>, simulated_time: f64) -> bool;
+    /// Keeps a checkpoint taken at `progress`; false when it cannot, and the packing stops.
+    fn checkpoint(&mut self, data: Vec<u8>, progress: Progress) -> bool;
     /// Something the user should know, such as a checkpoint that cannot be used.
     fn warning(&mut self, text: String);
     fn stop_requested(&self) -> bool;
@@ -439,8 +438,8 @@ impl Observer for Relay<'_> {
         let _ = self.sender.try_send(Message::Progress(progress));
     }
 
-    fn checkpoint(&mut self, data: Vec<u8>, simulated_time: f64) -> bool {
-        self.sender.blocking_send(Message::Checkpoint(data, simulated_time)).is_ok()
+    fn checkpoint(&mut self, data: Vec<u8>, progress: Progress) -> bool {
+        self.sender.blocking_send(Message::Checkpoint(data, progress)).is_ok()
     }
 
     fn warning(&mut self, text: String) {
@@ -492,7 +491,7 @@ pub(crate) fn simulate(
         if last_checkpoint.elapsed() >= interval {
             match checkpoint_data(&packing) {
                 Ok(data) => {
-                    if !observer.checkpoint(data, packing.simulation.time) {
+                    if !observer.checkpoint(data, packing.progress()) {
                         return Outcome::Stopped(Box::new(packing));
                     }
                 }
@@ -505,6 +504,11 @@ pub(crate) fn simulate(
         Ok(result) => Outcome::Done(Box::new(result)),
         Err(e) => Outcome::Failed(e.to_string()),
     }
+}
+
+/// What the store keeps of a packing's progress beside its checkpoint.
+fn stage(p: &Progress) -> Stage {
+    Stage { phase: p.phase.name().into(), grains: p.grains as u64, mass_created: p.created }
 }
 
 /// A checkpoint: this version's checkpoint format number followed by the packing.

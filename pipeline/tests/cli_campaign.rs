@@ -141,6 +141,19 @@ fn ctrl_c_checkpoints_running_jobs_and_returns_them_to_pending() {
     assert_eq!(in_progress[0]["state"].as_str(), Some("pending"), "{in_progress}");
     let simulated = in_progress[0]["checkpoint"][0].as_f64().expect("a checkpoint written on stopping");
     assert!(simulated > 0.0, "{in_progress}");
+    // The checkpoint says where the packing stood: each grain of the 0.03 kg weighs what a
+    // sphere between the sieves' 5.6 and 8 mm does (ρ = 2650 kg/m³), so while the generation
+    // runs the share of the mass created lies between the grains times those two (at most 1).
+    let stage = &in_progress[0]["stage"];
+    let (grains, created) = (stage["grains"].as_f64().unwrap(), stage["mass_created"].as_f64().unwrap());
+    let share = |d: f64| 2650.0 * std::f64::consts::PI / 6.0 * d.powi(3) / 0.03;
+    match stage["phase"].as_str() {
+        Some("generation") => {
+            assert!((grains * share(0.0056)).min(1.0) <= created && created <= grains * share(0.008), "{stage}")
+        }
+        Some("shaking" | "damping") => assert_eq!(created, 1.0, "{stage}"),
+        _ => panic!("no phase: {stage}"),
+    }
     let resumed = ok(&["resume", "stop", "--db", db, "--quiet"]);
     assert!(resumed.contains("4 done"), "{resumed}");
     let log = std::fs::read_to_string(dir.path().join("stop.log")).unwrap();

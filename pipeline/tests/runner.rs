@@ -62,7 +62,7 @@ async fn a_checkpoint_of_another_version_stops_the_run_untouched_unless_discardi
     // format number 3 (one varint byte), followed by a packing this version cannot decode.
     let claimed = store.claim(&campaign.name, "old-sedpack").await.unwrap().unwrap();
     let old = [3u8, 0x2a, 0x07, 0x00, 0x13];
-    store.save_checkpoint(&claimed.id, "old-sedpack", &old, 2.5).await.unwrap();
+    store.save_checkpoint(&claimed.id, "old-sedpack", &old, 2.5, None).await.unwrap();
     assert!(store.release(&claimed.id, "old-sedpack").await.unwrap());
 
     // The worker that claims it stops the run instead of starting the packing over.

@@ -191,8 +191,9 @@ fn a_bonded_rod_dropped_on_end_comes_to_rest_lying_down() {
 
 /// The horizontal reach of a turned grain (how far it extends from its centre in the plane,
 /// what a cylinder must leave it) against a brute-force maximum over its surface: for a box the
-/// corners, computed by hand from the rotation; for an ellipsoid points of its surface on a
-/// 720 × 360 grid of angles, which can only fall short of the maximum, by less than 1e-4.
+/// corners, computed by hand from the rotation; for an ellipsoid, and for each sphere of a
+/// bonded rod, points of the surface on a 720 × 360 grid of angles, which can only fall short
+/// of the maximum, by less than 1e-4 of it.
 #[test]
 fn the_horizontal_reach_of_a_turned_grain_is_its_widest_point_in_the_plane() {
     let turns = [
@@ -223,6 +224,21 @@ fn the_horizontal_reach_of_a_turned_grain_is_its_widest_point_in_the_plane() {
         }
         let reach = Shape::Ellipsoid { semi_axes }.horizontal_reach(&turn);
         assert!(reach >= sampled - 1e-12 && reach - sampled < 1e-4 * reach, "ellipsoid: {reach} vs {sampled}");
+
+        let rod = bonded_grain(&FormParameters::new(0.03, 0.01, 0.01).unwrap()).unwrap();
+        let mut sampled = 0.0_f64;
+        for sphere in &rod.spheres {
+            for i in 0..720 {
+                for j in 0..=360 {
+                    let (phi, theta) =
+                        (i as f64 * std::f64::consts::PI / 360.0, j as f64 * std::f64::consts::PI / 360.0);
+                    let unit = Vector3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
+                    sampled = sampled.max(horizontal(turn * (sphere.center + unit * sphere.radius)));
+                }
+            }
+        }
+        let reach = Shape::from(&rod).horizontal_reach(&turn);
+        assert!(reach >= sampled - 1e-12 && reach - sampled < 1e-4 * reach, "bonded rod: {reach} vs {sampled}");
     }
     assert_eq!(Shape::Sphere { radius: 0.01 }.horizontal_reach(&turns[1]), 0.01);
 }

@@ -25,7 +25,7 @@ use sqlx::sqlite::{
 pub use error::StoreError;
 pub use types::{
     Campaign, CampaignStatus, Checkpoint, ClaimedJob, ExportRow, Failure, GrainStatistic, JobResult, JobState, NewJob,
-    Progress, RunningJob, StoredJob,
+    Progress, RunningJob, Stage, StoredJob,
 };
 
 /// How long a statement waits for another connection's lock before it fails.
@@ -407,7 +407,8 @@ impl Store {
         Ok(requeued)
     }
 
-    /// Saves (replacing any earlier one) the job's checkpoint; counts as a heartbeat.
+    /// Saves (replacing any earlier one) the job's checkpoint, taken at `simulated_time` and
+    /// `stage`; counts as a heartbeat.
     /// Fails with [`StoreError::NotOwner`], writing nothing, unless the job is running for `worker_id`.
     pub async fn save_checkpoint(
         &self,
@@ -415,6 +416,7 @@ impl Store {
         worker_id: &str,
         data: &[u8],
         simulated_time: f64,
+        stage: Option<&Stage>,
     ) -> Result<(), StoreError> {
         let now = now();
         let mut tx = self.pool.begin_with(sql::BEGIN_IMMEDIATE).await.map_err(self.db())?;
@@ -424,6 +426,9 @@ impl Store {
             .bind(data)
             .bind(simulated_time)
             .bind(now)
+            .bind(stage.map(|s| s.phase.as_str()))
+            .bind(stage.map(|s| s.grains as i64))
+            .bind(stage.map(|s| s.mass_created))
             .execute(&mut *tx)
             .await
             .map_err(self.db())?;
@@ -456,13 +461,30 @@ impl Store {
         ) = sqlx::query_as(sql::STATUS_COUNTS).bind(campaign_id).fetch_one(&mut *tx).await.map_err(self.db())?;
         let failures: Vec<(String, u32, String)> =
             sqlx::query_as(sql::FAILURES).bind(campaign_id).fetch_all(&mut *tx).await.map_err(self.db())?;
-        type ProgressRow = (String, String, Option<String>, u32, Option<f64>, Option<f64>, Option<f64>);
+        type ProgressRow = (
+            String,
+            String,
+            Option<String>,
+            u32,
+            Option<f64>,
+            Option<f64>,
+            Option<f64>,
+            Option<String>,
+            Option<i64>,
+            Option<f64>,
+        );
         let in_progress: Vec<ProgressRow> =
             sqlx::query_as(sql::IN_PROGRESS).bind(campaign_id).fetch_all(&mut *tx).await.map_err(self.db())?;
         tx.commit().await.map_err(self.db())?;
         let in_progress = in_progress
             .into_iter()
-            .map(|(job_id, state, worker_id, attempts, started_at, simulated_time, written_at)| {
+            .map(|(job_id, state, worker_id, attempts, started_at, simulated_time, written_at, phase, grains, mass)| {
+                let stage = match (phase, grains, mass) {
+                    (Some(phase), Some(grains), Some(mass_created)) => {
+                        Some(Stage { phase, grains: grains as u64, mass_created })
+                    }
+                    _ => None,
+                };
                 Ok(Progress {
                     state: self.state(&job_id, &state)?,
                     job_id,
@@ -470,6 +492,7 @@ impl Store {
                     attempts,
                     started_at,
                     checkpoint: simulated_time.zip(written_at),
+                    stage,
                 })
             })
             .collect::<Result<_, StoreError>>()?;

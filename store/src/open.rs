@@ -30,6 +30,7 @@ fn migrator() -> Migrator {
         migration(2, "job format and experiment", include_str!("../migrations/0002_job_format_and_experiment.sql")),
         migration(3, "executor", include_str!("../migrations/0003_executor.sql")),
         migration(4, "fluid and imbrication", include_str!("../migrations/0004_fluid_and_imbrication.sql")),
+        migration(5, "checkpoint stage", include_str!("../migrations/0005_checkpoint_stage.sql")),
     ])
 }
 

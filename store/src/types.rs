@@ -120,6 +120,16 @@ pub struct Checkpoint {
     pub written_at: f64,
 }
 
+/// Where a packing stood when its checkpoint was written, as the caller described it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Stage {
+    /// The packing's phase by name ("generation", "shaking", "damping").
+    pub phase: String,
+    pub grains: u64,
+    /// Fraction of the target mass created.
+    pub mass_created: f64,
+}
+
 /// A job some worker holds, for deciding whether that worker is still alive.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunningJob {
@@ -169,6 +179,8 @@ pub struct Progress {
     pub started_at: Option<f64>,
     /// Simulated time (s) and unix time of its last checkpoint in the database, if any.
     pub checkpoint: Option<(f64, f64)>,
+    /// Where the packing stood at that checkpoint (None for checkpoints of sedpack before 0.2.1).
+    pub stage: Option<Stage>,
 }
 
 /// One job of an export, with its result and grain statistics if it is done.

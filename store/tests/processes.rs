@@ -82,7 +82,7 @@ async fn child_process_killed() {
         store.complete(&job.id, &worker_id, &result(0.36), &statistics(0.5)).await.unwrap();
     }
     let job = store.claim(CAMPAIGN, &worker_id).await.unwrap().unwrap();
-    store.save_checkpoint(&job.id, &worker_id, b"mid-packing", 4.0).await.unwrap();
+    store.save_checkpoint(&job.id, &worker_id, b"mid-packing", 4.0, None).await.unwrap();
     std::fs::write(report, "ready").unwrap();
     tokio::time::sleep(Duration::from_secs(600)).await;
 }

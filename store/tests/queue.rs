@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use common::*;
 use serde_json::json;
-use store::{JobResult, JobState, Store, StoreError};
+use store::{JobResult, JobState, Stage, Store, StoreError};
 
 #[tokio::test]
 async fn campaigns_are_upserted_by_name() {
@@ -79,7 +79,7 @@ async fn a_worker_that_lost_its_job_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let store = store_with_jobs(&db_path(&dir), 1).await;
     let first = store.claim(CAMPAIGN, "w1").await.unwrap().unwrap();
-    store.save_checkpoint(&first.id, "w1", b"w1 state", 1.0).await.unwrap();
+    store.save_checkpoint(&first.id, "w1", b"w1 state", 1.0, None).await.unwrap();
 
     // The caller decided w1 is gone; w2 takes the job over from w1's checkpoint.
     assert!(store.release(&first.id, "w1").await.unwrap());
@@ -90,7 +90,7 @@ async fn a_worker_that_lost_its_job_writes_nothing() {
         store.complete(&first.id, "w1", &result(0.99), &statistics(0.9)).await,
         store.fail(&first.id, "w1", "w1 failed").await,
         store.heartbeat(&first.id, "w1").await,
-        store.save_checkpoint(&first.id, "w1", b"stale", 2.0).await,
+        store.save_checkpoint(&first.id, "w1", b"stale", 2.0, None).await,
     ] {
         let error = outcome.unwrap_err();
         assert!(matches!(error, StoreError::NotOwner { .. }), "{error:?}");
@@ -146,7 +146,7 @@ async fn released_jobs_return_to_pending_with_their_checkpoint() {
     let dir = tempfile::tempdir().unwrap();
     let store = store_with_jobs(&db_path(&dir), 2).await;
     let claimed = store.claim(CAMPAIGN, "w1").await.unwrap().unwrap();
-    store.save_checkpoint(&claimed.id, "w1", b"half way", 3.0).await.unwrap();
+    store.save_checkpoint(&claimed.id, "w1", b"half way", 3.0, None).await.unwrap();
     assert!(!store.release(&claimed.id, "someone else").await.unwrap());
     assert!(store.release(&claimed.id, "w1").await.unwrap());
     assert!(!store.release(&claimed.id, "w1").await.unwrap());
@@ -168,7 +168,11 @@ async fn status_says_how_far_running_and_interrupted_jobs_are() {
     let a = store.claim(CAMPAIGN, "w1").await.unwrap().unwrap();
     let b = store.claim(CAMPAIGN, "w2").await.unwrap().unwrap();
     let c = store.claim(CAMPAIGN, "w3").await.unwrap().unwrap();
-    store.save_checkpoint(&a.id, "w1", b"a", 1.5).await.unwrap();
+    let stage = Stage { phase: "generation".into(), grains: 1972, mass_created: 0.382 };
+    store.save_checkpoint(&a.id, "w1", b"a", 1.5, Some(&stage)).await.unwrap();
+    store.save_checkpoint(&c.id, "w3", b"c", 0.5, Some(&stage)).await.unwrap();
+    // A checkpoint that does not say where it stood replaces the last one's stage too.
+    store.save_checkpoint(&c.id, "w3", b"c", 0.75, None).await.unwrap();
     let in_progress = store.status(CAMPAIGN).await.unwrap().in_progress;
     let seen: Vec<_> = in_progress
         .iter()
@@ -179,10 +183,12 @@ async fn status_says_how_far_running_and_interrupted_jobs_are() {
         [
             (a.id.as_str(), JobState::Running, Some("w1"), Some(1.5)),
             (b.id.as_str(), JobState::Running, Some("w2"), None),
-            (c.id.as_str(), JobState::Running, Some("w3"), None),
+            (c.id.as_str(), JobState::Running, Some("w3"), Some(0.75)),
         ],
         "the fourth job, pending without a checkpoint, is not in progress"
     );
+    let stages: Vec<_> = in_progress.iter().map(|p| p.stage.clone()).collect();
+    assert_eq!(stages, [Some(stage.clone()), None, None]);
     assert!(in_progress.iter().all(|p| p.started_at.is_some() && p.attempts == 1));
 
     // Stopped with its checkpoint, a job stays in progress as pending; a failed one leaves.
@@ -192,6 +198,7 @@ async fn status_says_how_far_running_and_interrupted_jobs_are() {
     let seen: Vec<_> = in_progress.iter().map(|p| (p.job_id.as_str(), p.state, p.worker_id.as_deref())).collect();
     assert_eq!(seen, [(a.id.as_str(), JobState::Pending, None), (c.id.as_str(), JobState::Running, Some("w3"))]);
     assert_eq!((in_progress[0].started_at, in_progress[0].checkpoint.map(|c| c.0)), (None, Some(1.5)));
+    assert_eq!(in_progress[0].stage, Some(stage), "a stopped job keeps its checkpoint's stage");
     store.close().await;
 }
 
@@ -200,7 +207,7 @@ async fn failed_jobs_keep_their_error_until_retried() {
     let dir = tempfile::tempdir().unwrap();
     let store = store_with_jobs(&db_path(&dir), 2).await;
     let claimed = store.claim(CAMPAIGN, "w1").await.unwrap().unwrap();
-    store.save_checkpoint(&claimed.id, "w1", b"before the crash", 1.0).await.unwrap();
+    store.save_checkpoint(&claimed.id, "w1", b"before the crash", 1.0, None).await.unwrap();
     store.fail(&claimed.id, "w1", "no packing surface found").await.unwrap();
     assert!(matches!(store.fail(&claimed.id, "w1", "again").await, Err(StoreError::NotOwner { .. })));
     assert_eq!(store.load_checkpoint(&claimed.id).await.unwrap(), None, "a retry starts afresh");
@@ -307,11 +314,11 @@ async fn checkpoints_round_trip_and_are_overwritten() {
     assert_eq!(store.load_checkpoint(&claimed.id).await.unwrap(), None);
 
     let first: Vec<u8> = (0..=255).cycle().take(100_000).collect();
-    store.save_checkpoint(&claimed.id, "w1", &first, 1.25).await.unwrap();
+    store.save_checkpoint(&claimed.id, "w1", &first, 1.25, None).await.unwrap();
     let loaded = store.load_checkpoint(&claimed.id).await.unwrap().unwrap();
     assert_eq!((loaded.data, loaded.simulated_time), (first, 1.25));
 
-    store.save_checkpoint(&claimed.id, "w1", b"later", 2.5).await.unwrap();
+    store.save_checkpoint(&claimed.id, "w1", b"later", 2.5, None).await.unwrap();
     let loaded_again = store.load_checkpoint(&claimed.id).await.unwrap().unwrap();
     assert_eq!((loaded_again.data.as_slice(), loaded_again.simulated_time), (&b"later"[..], 2.5));
     assert!(loaded_again.written_at >= loaded.written_at);

@@ -432,11 +432,16 @@ fn unix_now() -> f64 {
 }
 
 /// A local job in progress in words: "running for 32 min 10 s on vm:1:0 (attempt 2); checkpoint
-/// at 1.90 s simulated, 2 min 05 s ago".
+/// at 1.90 s simulated (generation, 1972 grains, 38 % of the mass), 2 min 05 s ago".
 fn progress_text(p: &Progress, now: f64) -> String {
     let ago = |t: f64| duration((now - t).max(0.0));
+    // The share of the mass created says how far the generation is, which simulated time does not.
+    let stage = match &p.stage {
+        Some(s) => format!(" ({}, {} grains, {:.0} % of the mass)", s.phase, s.grains, 100.0 * s.mass_created),
+        None => String::new(),
+    };
     let checkpoint = match p.checkpoint {
-        Some((simulated, written)) => format!("checkpoint at {simulated:.2} s simulated, {} ago", ago(written)),
+        Some((simulated, written)) => format!("checkpoint at {simulated:.2} s simulated{stage}, {} ago", ago(written)),
         None => "no checkpoint yet".into(),
     };
     match (&p.worker_id, p.started_at) {
@@ -519,6 +524,7 @@ fn csv_value(value: Option<&Value>) -> String {
 #[cfg(test)]
 mod tests {
     use serde_json::json;
+    use store::Stage;
 
     use super::*;
 
@@ -540,14 +546,18 @@ mod tests {
             attempts: 2,
             started_at: Some(1000.0),
             checkpoint: Some((1.9, 2800.0)),
+            stage: Some(Stage { phase: "generation".into(), grains: 1972, mass_created: 0.382 }),
         };
         assert_eq!(
             progress_text(&running, 2930.0),
-            "running for 32 min 10 s on vm:1:0 (attempt 2); checkpoint at 1.90 s simulated, 2 min 10 s ago"
+            "running for 32 min 10 s on vm:1:0 (attempt 2); checkpoint at 1.90 s simulated \
+             (generation, 1972 grains, 38 % of the mass), 2 min 10 s ago"
         );
-        let fresh = Progress { checkpoint: None, ..running.clone() };
+        let old = Progress { stage: None, ..running.clone() };
+        assert!(progress_text(&old, 2930.0).ends_with("checkpoint at 1.90 s simulated, 2 min 10 s ago"));
+        let fresh = Progress { checkpoint: None, stage: None, ..running.clone() };
         assert!(progress_text(&fresh, 1030.0).ends_with("(attempt 2); no checkpoint yet"));
-        let stopped = Progress { state: JobState::Pending, worker_id: None, started_at: None, ..running };
+        let stopped = Progress { state: JobState::Pending, worker_id: None, started_at: None, stage: None, ..running };
         assert_eq!(
             progress_text(&stopped, 2810.0),
             "pending; checkpoint at 1.90 s simulated, 10.0 s ago: `resume` continues from it"

@@ -137,6 +137,9 @@ pub struct TaskProgress {
     pub time: f64,
     pub grains: usize,
     pub contacts: usize,
+    /// Fraction of the target mass created (absent from the files of sedpack before 0.2.1).
+    #[serde(default)]
+    pub mass_created: Option<f64>,
 }
 
 impl JobDir {
@@ -376,5 +379,24 @@ mod tests {
         job.append_event(&done).unwrap();
         assert_eq!(job.events(), [event, done]);
         assert_eq!(file_name("rhine u1/β"), "rhine_u1__");
+    }
+
+    #[test]
+    fn progress_reads_back_and_an_older_task_s_file_without_the_mass_still_reads() {
+        let dir = tempfile::tempdir().unwrap();
+        let job = JobDir { path: dir.path().into() };
+        assert_eq!(job.progress(), None);
+        let progress = TaskProgress {
+            phase: "generation".into(),
+            time: 1.5,
+            grains: 900,
+            contacts: 1200,
+            mass_created: Some(0.4),
+        };
+        job.write_progress(&progress).unwrap();
+        assert_eq!(job.progress(), Some(progress.clone()));
+        fs::write(job.progress_file(), br#"{"phase": "shaking", "time": 2.0, "grains": 10, "contacts": 3}"#).unwrap();
+        let older = TaskProgress { phase: "shaking".into(), time: 2.0, grains: 10, contacts: 3, mass_created: None };
+        assert_eq!(job.progress(), Some(older));
     }
 }

@@ -192,13 +192,18 @@ impl Observer for TaskObserver<'_> {
             return;
         }
         self.last_progress = Some(Instant::now());
-        let progress =
-            TaskProgress { phase: p.phase.name().into(), time: p.time, grains: p.grains, contacts: p.contacts };
+        let progress = TaskProgress {
+            phase: p.phase.name().into(),
+            time: p.time,
+            grains: p.grains,
+            contacts: p.contacts,
+            mass_created: Some(p.created),
+        };
         // Progress is for display only: a failed write is retried next time.
         let _ = self.dir.write_progress(&progress);
     }
 
-    fn checkpoint(&mut self, data: Vec<u8>, _simulated_time: f64) -> bool {
+    fn checkpoint(&mut self, data: Vec<u8>, _progress: Progress) -> bool {
         // Going on without this checkpoint still ends in a result; the next one may succeed.
         if let Err(e) = write_atomically(&self.dir.checkpoint(), &data) {
             eprintln!("sedpack: warning: {e:#}");

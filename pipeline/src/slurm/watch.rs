@@ -107,8 +107,9 @@ async fn show_tasks(
         slurm.get(&task).filter(|t| t.state == "RUNNING")?;
         let p = submission.run.job(&r.job_id).progress()?;
         let id = r.job_id.get(..8).unwrap_or(&r.job_id);
+        let mass = p.mass_created.map(|m| format!(" ({:.0} % of the mass)", 100.0 * m)).unwrap_or_default();
         Some(format!(
-            "task {task}, job {id}: {} t = {:.3} s, {} grains, {} contacts",
+            "task {task}, job {id}: {} t = {:.3} s, {} grains{mass}, {} contacts",
             p.phase, p.time, p.grains, p.contacts
         ))
     });
