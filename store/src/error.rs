@@ -23,6 +23,14 @@ pub enum StoreError {
     #[error("{}: setting up the schema failed: {source}", .path.display())]
     Migrate { path: PathBuf, source: sqlx::migrate::MigrateError },
 
+    #[error(
+        "{}: written by a newer sedpack (its schema has migration {applied}, this sedpack knows \
+         migrations up to {known}); open it with the sedpack that wrote it, or choose another file \
+         with --db; it was left unchanged",
+        .path.display()
+    )]
+    Newer { path: PathBuf, applied: i64, known: i64 },
+
     #[error("{}: {source}", .path.display())]
     Database { path: PathBuf, source: sqlx::Error },
 

@@ -5,7 +5,7 @@ use std::io::{ErrorKind, Read};
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use sqlx::migrate::{Migration, MigrationType, Migrator};
+use sqlx::migrate::{MigrateError, Migration, MigrationType, Migrator};
 use sqlx::sqlite::{SqliteConnectOptions, SqliteConnection};
 use sqlx::{ConnectOptions, Connection, SqlStr};
 
@@ -69,10 +69,13 @@ async fn set_up(conn: &mut SqliteConnection, path: &Path, busy_timeout: Duration
     let mut tx = conn.begin_with(sql::BEGIN_IMMEDIATE).await.map_err(|e| refused_or_database(path, e))?;
     check_ours_or_empty(&mut tx, path).await?;
     // run_direct rather than run: run's Acquire bound makes the future not Send (sqlx's own advice).
-    migrator()
-        .run_direct(None, &mut *tx, false)
-        .await
-        .map_err(|source| StoreError::Migrate { path: path.to_path_buf(), source })?;
+    let migrator = migrator();
+    let known = migrator.iter().map(|m| m.version).max().unwrap_or(0);
+    // A migration this sedpack does not have is refused before any is applied.
+    migrator.run_direct(None, &mut *tx, false).await.map_err(|source| match source {
+        MigrateError::VersionMissing(applied) => StoreError::Newer { path: path.to_path_buf(), applied, known },
+        source => StoreError::Migrate { path: path.to_path_buf(), source },
+    })?;
     tx.commit().await.map_err(|e| refused_or_database(path, e))?;
     enter_wal(conn, path, busy_timeout).await
 }

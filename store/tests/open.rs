@@ -89,6 +89,37 @@ async fn reopening_keeps_the_data() {
 }
 
 #[tokio::test]
+async fn a_database_of_a_newer_sedpack_is_refused_untouched() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = db_path(&dir);
+    store_with_jobs(&path, 2).await.close().await;
+    // A later sedpack's migration, as sqlx records one.
+    let mut conn = raw(&path).await;
+    sqlx::query(
+        "INSERT INTO _sqlx_migrations (version, description, success, checksum, execution_time) \
+         VALUES (9999, 'from the future', TRUE, x'00', 0)",
+    )
+    .execute(&mut conn)
+    .await
+    .unwrap();
+    conn.close().await.unwrap();
+    for _ in 0..2 {
+        let error = Store::open(&path).await.unwrap_err();
+        assert!(matches!(error, StoreError::Newer { applied: 9999, .. }), "{error:?}");
+        let text = error.to_string();
+        assert!(text.contains("written by a newer sedpack") && text.contains("migration 9999"), "{text}");
+    }
+    // What it held is still there: the refusal wrote nothing.
+    let mut conn = raw(&path).await;
+    let jobs: i64 = sqlx::query_scalar("SELECT COUNT(*) FROM jobs").fetch_one(&mut conn).await.unwrap();
+    let migrations: i64 =
+        sqlx::query_scalar("SELECT COUNT(*) FROM _sqlx_migrations").fetch_one(&mut conn).await.unwrap();
+    let files = std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/migrations")).unwrap().count() as i64;
+    assert_eq!((jobs, migrations), (2, files + 1));
+    conn.close().await.unwrap();
+}
+
+#[tokio::test]
 async fn an_existing_empty_file_becomes_a_database() {
     let dir = tempfile::tempdir().unwrap();
     let path = db_path(&dir);
