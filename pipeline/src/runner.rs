@@ -288,16 +288,17 @@ impl Worker {
     /// Checkpoints a packing stopped by Ctrl-C (or by another worker's failure), so that `resume`
     /// loses none of the work done since its last checkpoint.
     async fn keep(&self, job: &str, packing: &Packing) {
-        let time = packing.simulation.time;
-        let stage = stage(&packing.progress());
+        let p = packing.progress();
         let saved = match checkpoint_data(packing) {
-            Ok(data) => {
-                self.store.save_checkpoint(job, &self.id, &data, time, Some(&stage)).await.map_err(anyhow::Error::from)
-            }
+            Ok(data) => self
+                .store
+                .save_checkpoint(job, &self.id, &data, p.time, Some(&stage(&p)))
+                .await
+                .map_err(anyhow::Error::from),
             Err(e) => Err(e.into()),
         };
         match saved {
-            Ok(()) => info!(job, simulated_time = time, "checkpoint on stopping"),
+            Ok(()) => info!(job, simulated_time = p.time, "checkpoint on stopping"),
             Err(e) => warn!(job, error = %e, "checkpoint on stopping not saved; resume continues from the last one"),
         }
     }
