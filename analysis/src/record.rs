@@ -8,6 +8,8 @@ use serde::{Deserialize, Serialize};
 use solver::fabric::Imbrication;
 use solver::porosity::ProfilePoint;
 
+use crate::paper::PaperPorosity;
+
 /// A measured porosity to compare the simulated one with (Table 6).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Experiment {
@@ -31,6 +33,8 @@ pub struct JobRecord {
     pub size_case: Option<String>,
     /// Measured porosity, when the campaign gives one.
     pub experiment: Option<Experiment>,
+    /// The paper's simulated porosity, when the packing is one of its setups (Tables 5–8).
+    pub paper: Option<PaperPorosity>,
     /// The fluid forces the packing was deposited with, in words ("drag, still water"); None:
     /// buoyancy only, the first paper's protocol.
     pub fluid: Option<String>,

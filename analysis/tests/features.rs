@@ -16,6 +16,7 @@ fn record(id: &str, porosity: f64, grains: &[(f64, f64)]) -> JobRecord {
         grain_statistics: grain_statistics(grains),
         size_case: None,
         experiment: None,
+        paper: None,
         fluid: None,
         imbrication: None,
         cost: Cost::default(),

@@ -8,6 +8,7 @@ use analysis::analyse;
 use analysis::dataset::mixture_feature_names;
 use analysis::form_factors::{form_feature_names, grain_statistics};
 use analysis::model::LinearModel;
+use analysis::paper::PaperPorosity;
 use analysis::record::{CampaignSummary, Cost, Experiment, JobRecord};
 use analysis::report::{ReportFiles, write_report};
 use analysis::selection::SelectionOptions;
@@ -72,6 +73,7 @@ fn mixture_campaign() -> Vec<JobRecord> {
                         grain_statistics: stats,
                         size_case: None,
                         experiment: None,
+                        paper: None,
                         fluid: None,
                         imbrication: None,
                         cost: Cost::default(),
@@ -251,6 +253,7 @@ fn validation_campaign() -> Vec<JobRecord> {
                 grain_statistics: grain_statistics(&[(fl, el); 3]),
                 size_case: None,
                 experiment: Some(experiment),
+                paper: None,
                 fluid: None,
                 imbrication: None,
                 // Seeds 1–3: 4,000, 4,010, 4,020 grains, 2.9–3.1 s simulated, 1, 2 and 1.5 h.
@@ -296,6 +299,34 @@ fn a_single_form_validation_report_has_table_6() {
     assert_eq!(rows.len(), 6);
     assert!(md.contains("single-form packings"));
     check_html(out.path(), 3);
+}
+
+#[test]
+fn packings_of_the_papers_setups_are_compared_with_its_simulations() {
+    // Table 7's U7 run three times, and one B50 run of a Table 8 setup (no spread given).
+    let mut records: Vec<JobRecord> = validation_campaign().into_iter().take(4).collect();
+    let table7 = PaperPorosity { table: "Table 7".into(), porosity: 0.291, std: Some(0.001) };
+    let table8 = PaperPorosity { table: "Table 8".into(), porosity: 0.242, std: None };
+    for (r, n) in records.iter_mut().zip([0.288, 0.293, 0.290, 0.250]) {
+        r.porosity = n;
+        r.experiment = None;
+        r.paper = Some(if r.job_id.starts_with("U1") { table7.clone() } else { table8.clone() });
+    }
+    let out = tempfile::tempdir().unwrap();
+    let files = report("validation", &records, out.path());
+    let md = std::fs::read_to_string(&files.markdown).unwrap();
+    let section = md.find("## Comparison with the paper's simulations").expect(&md);
+    // Mean 0.290333, population std 0.002055; 0.290333 − 0.291 = −0.000667 → −0.001.
+    assert!(
+        md[section..]
+            .contains("| grains.size = U1 | 0.288, 0.293, 0.290 | 0.290 ± 0.002 | 0.291 ± 0.001 | Table 7 | -0.001 |"),
+        "{md}"
+    );
+    // One run: its value, no spread; 0.250 − 0.242 = 0.008.
+    assert!(md[section..].contains("| grains.size = U3 | 0.250 | 0.250 | 0.242 | Table 8 | 0.008 |"), "{md}");
+    // (0.000667 + 0.008) / 2 = 0.004333.
+    assert!(md[section..].contains("Mean absolute difference over 2 setups: 0.0043."), "{md}");
+    assert!(!md.contains("## Comparison with experiment"), "no experiment, no such section");
 }
 
 #[test]
@@ -361,6 +392,7 @@ fn shape_records(size_case: Option<&str>) -> Vec<JobRecord> {
                 grain_statistics: grain_statistics(&[(form, form); 3]),
                 size_case: size_case.map(String::from),
                 experiment: None,
+                paper: None,
                 fluid: None,
                 imbrication: None,
                 cost: Cost::default(),
@@ -459,6 +491,7 @@ fn a_campaign_with_and_without_drag_compares_them_seed_by_seed() {
                 grain_statistics: grain_statistics(&[(0.6, 0.7); 3]),
                 size_case: None,
                 experiment: None,
+                paper: None,
                 fluid: fluid.map(String::from),
                 imbrication: None,
                 cost: Cost::default(),
@@ -513,6 +546,7 @@ fn the_imbrication_of_each_setup_is_summed_over_its_runs() {
                 grain_statistics: grain_statistics(&[(0.8, 0.5); 3]),
                 size_case: None,
                 experiment: None,
+                paper: None,
                 fluid: Some(fluid.into()),
                 imbrication: Some(f),
                 cost: Cost::default(),

@@ -4,6 +4,7 @@
 
 use std::collections::BTreeMap;
 
+use analysis::paper::simulated_porosity;
 use analysis::record::Cost;
 use analysis::{CampaignSummary, Experiment, JobRecord};
 use anyhow::Context;
@@ -115,9 +116,9 @@ pub fn result_rows(result: &PackingResult) -> (JobResult, Vec<GrainStatistic>) {
     (row, statistics)
 }
 
-/// A job as the analysis reads it, its grains of the Table 3 case `size_case`; None for a job
-/// without a result.
-pub fn job_record(row: &ExportRow, size_case: Option<&str>) -> anyhow::Result<Option<JobRecord>> {
+/// A job as the analysis reads it, with what its packing `spec` says (the Table 3 case of its
+/// grains, the paper's porosity for its setup); None for a job without a result.
+pub fn job_record(row: &ExportRow, spec: Option<&PackingSpec>) -> anyhow::Result<Option<JobRecord>> {
     let Some(result) = &row.result else { return Ok(None) };
     let profile: Vec<ProfilePoint> = serde_json::from_value(result.profile.clone())
         .with_context(|| format!("job {}: the stored porosity profile is not [{{z, n}}, …]", row.job_id))?;
@@ -143,8 +144,9 @@ pub fn job_record(row: &ExportRow, size_case: Option<&str>) -> anyhow::Result<Op
             .iter()
             .map(|s| (s.name.clone(), (s.mean, s.std)))
             .collect::<BTreeMap<_, _>>(),
-        size_case: size_case.map(String::from),
+        size_case: spec.and_then(|s| s.grains.size.case()).map(|c| c.name.to_string()),
         experiment: row.experiment_porosity.map(|porosity| Experiment { porosity, std: row.experiment_std }),
+        paper: spec.and_then(simulated_porosity),
         fluid: fluid.map(|f| f.describe()),
         imbrication,
         cost: Cost { grains: result.particles, simulated_time: result.simulated_time, wall_time: result.wall_time },

@@ -61,6 +61,7 @@ pub fn write_report(
     packings_section(&mut blocks, records)?;
     setups_section(&mut blocks, records);
     experiment_section(&mut blocks, records);
+    paper_section(&mut blocks, records);
     shape_section(&mut blocks, records)?;
     fluid_section(&mut blocks, records);
     match (dataset, selection) {
@@ -360,48 +361,87 @@ fn setups_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
 
 /// Table 6: runs of the same setup (parameters apart from the seed) against the measurement.
 fn experiment_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
-    let groups = grouped(records, |r| Some((setup_label(r), r.experiment?)));
+    comparison(
+        blocks,
+        "Comparison with experiment",
+        "Like Table 6: the runs of each setup (differing only in seed), their mean and standard deviation, the measured porosity, the difference simulated − measured and the relative error (simulated − measured)/measured.",
+        ["simulated n (mean ± std)", "measured n", "difference", "relative error (%)"],
+        &grouped(records, |r| Some((setup_label(r), r.experiment?))),
+        |mean, experiment| {
+            let measured = experiment.porosity;
+            let shown = match experiment.std {
+                Some(std) => format!("{measured:.3} ± {std:.3}"),
+                None => format!("{measured:.3} (spread not given)"),
+            };
+            (
+                measured,
+                vec![shown, format!("{:.3}", mean - measured), format!("{:.2}", 100.0 * (mean - measured) / measured)],
+            )
+        },
+    );
+}
+
+/// Tables 5–8: the runs of each setup the paper simulated against the paper's runs.
+fn paper_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
+    comparison(
+        blocks,
+        "Comparison with the paper's simulations",
+        "Like Tables 5–8: the runs of each setup that is one of the paper's simulated setups (the table's domain, width, mass, shaking duration t_s and Table 3 case, meshes keeping their own forms, no fluid forces, and the paper's protocol and evaluation otherwise; seed, domain height, time limit and meshes may differ), their mean and standard deviation, the paper's porosity for the setup (the mean of its three runs ± their standard deviation, where the table gives one) and the difference sedpack − paper. The paper drew its grains from 63 scanned Rhine grains; a library of fewer meshes samples fewer shapes.",
+        ["sedpack n (mean ± std)", "paper n (mean ± std)", "source", "difference"],
+        &grouped(records, |r| Some((setup_label(r), r.paper.clone()?))),
+        |mean, paper| {
+            let shown = match paper.std {
+                Some(std) => format!("{:.3} ± {std:.3}", paper.porosity),
+                None => format!("{:.3}", paper.porosity),
+            };
+            (paper.porosity, vec![shown, paper.table.clone(), format!("{:.3}", mean - paper.porosity)])
+        },
+    );
+}
+
+/// A section comparing the runs of each setup with a reference porosity: `columns` head the
+/// runs' mean ± std and the cells that `reference` gives from the runs' mean (with the
+/// reference's porosity, for the mean absolute difference that closes the section).
+fn comparison<R>(
+    blocks: &mut Vec<Block>,
+    heading: &str,
+    text: &str,
+    columns: [&str; 4],
+    groups: &[((String, R), Vec<&JobRecord>)],
+    reference: impl Fn(f64, &R) -> (f64, Vec<String>),
+) {
     if groups.is_empty() {
         return;
     }
-    blocks.push(Block::Heading("Comparison with experiment".into()));
-    blocks.push(Block::Paragraph(
-        "Like Table 6: the runs of each setup (differing only in seed), their mean and standard deviation, the measured porosity, the difference simulated − measured and the relative error (simulated − measured)/measured.".into(),
-    ));
+    blocks.push(Block::Heading(heading.into()));
+    blocks.push(Block::Paragraph(text.into()));
     let mut differences = Vec::new();
     let rows = groups
         .iter()
-        .map(|((label, experiment), runs)| {
-            let runs: Vec<f64> = runs.iter().map(|r| r.porosity).collect();
-            // Population std of the runs, as Table 6 reports it (its U1 row: 0.382, 0.381, 0.386 → ± 0.002).
-            let (mean, std) = mean_std(&runs);
-            let spread = if runs.len() > 1 { format!("{mean:.3} ± {std:.3}") } else { format!("{mean:.3}") };
-            let measured = experiment.porosity;
-            differences.push((mean - measured).abs());
-            vec![
-                label.clone(),
-                runs.iter().map(|n| format!("{n:.3}")).collect::<Vec<_>>().join(", "),
-                spread,
-                match experiment.std {
-                    Some(std) => format!("{measured:.3} ± {std:.3}"),
-                    None => format!("{measured:.3} (spread not given)"),
-                },
-                format!("{:.3}", mean - measured),
-                format!("{:.2}", 100.0 * (mean - measured) / measured),
-            ]
+        .map(|((label, r), runs)| {
+            let (mean, [runs, spread]) = run_cells(runs);
+            let (porosity, cells) = reference(mean, r);
+            differences.push((mean - porosity).abs());
+            [vec![label.clone(), runs, spread], cells].concat()
         })
         .collect();
-    blocks.push(Block::Table {
-        header: ["setup", "runs", "simulated n (mean ± std)", "measured n", "difference", "relative error (%)"]
-            .map(String::from)
-            .to_vec(),
-        rows,
-    });
+    blocks
+        .push(Block::Table { header: ["setup", "runs"].into_iter().chain(columns).map(String::from).collect(), rows });
     blocks.push(Block::Paragraph(format!(
         "Mean absolute difference over {}: {:.4}.",
         setup_count(differences.len()),
         differences.iter().sum::<f64>() / differences.len() as f64
     )));
+}
+
+/// The porosities of a setup's runs, and their mean ± std (the mean alone for one run), with
+/// the mean.
+fn run_cells(runs: &[&JobRecord]) -> (f64, [String; 2]) {
+    let porosities: Vec<f64> = runs.iter().map(|r| r.porosity).collect();
+    // Population std of the runs, as Table 6 reports it (its U1 row: 0.382, 0.381, 0.386 → ± 0.002).
+    let (mean, std) = mean_std(&porosities);
+    let spread = if runs.len() > 1 { format!("{mean:.3} ± {std:.3}") } else { format!("{mean:.3}") };
+    (mean, [porosities.iter().map(|n| format!("{n:.3}")).collect::<Vec<_>>().join(", "), spread])
 }
 
 /// The records grouped by `key` (those without one left out), in the order keys first appear.
@@ -1150,6 +1190,7 @@ mod tests {
             grain_statistics: BTreeMap::new(),
             size_case: None,
             experiment: None,
+            paper: None,
             fluid: None,
             imbrication: None,
             cost: Cost::default(),

@@ -5,6 +5,7 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
+use analysis::paper::{PaperPorosity, simulated_porosity};
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
@@ -32,6 +33,8 @@ struct ResultFile<'a> {
     steps: u64,
     wall_time: f64,
     experiment: Option<analysis::Experiment>,
+    /// The paper's simulated porosity, for one of its setups (Tables 5–8).
+    paper: Option<PaperPorosity>,
     statistics: Map<String, Value>,
     profile: &'a [solver::porosity::ProfilePoint],
     /// With fluid forces on: the long axes' fabric against the flow.
@@ -61,6 +64,10 @@ pub fn run(args: &PackArgs) -> anyhow::Result<()> {
     table.row("porosity", format!("{:.4}", record.porosity));
     if let Some(e) = &job.experiment {
         table.row("experiment", format!("{:.4}{}", e.porosity, e.std.map(|s| format!(" ± {s}")).unwrap_or_default()));
+    }
+    if let Some(p) = &record.paper {
+        let std = p.std.map(|s| format!(" ± {s}")).unwrap_or_default();
+        table.row("paper", format!("{:.4}{std} (simulated, {})", p.porosity, p.table));
     }
     table
         .row(
@@ -140,6 +147,7 @@ fn result_file<'a>(job: &'a JobSpec, result: &'a PackingResult) -> ResultFile<'a
         steps: result.steps,
         wall_time: result.wall_time.as_secs_f64(),
         experiment: job.experiment,
+        paper: simulated_porosity(&job.packing),
         statistics,
         profile: &result.porosity.profile,
         imbrication: result.imbrication.as_ref(),

@@ -30,17 +30,17 @@ pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
             store.jobs(&args.name).await?,
         ))
     })?;
-    // The size case of each job, for the paper's models of that case.
-    let size_cases = jobs
+    // Each job's packing: its size case picks the paper's models, its setup the paper's tables.
+    let packings = jobs
         .iter()
         .map(|job| {
             let spec = stored::decode(job.format, &job.spec).with_context(|| format!("job {}", job.id))?;
-            Ok((job.id.clone(), spec.packing.grains.size.case().map(|c| c.name)))
+            Ok((job.id.clone(), spec.packing))
         })
         .collect::<anyhow::Result<HashMap<_, _>>>()?;
     let records: Vec<JobRecord> = rows
         .iter()
-        .filter_map(|row| job_record(row, size_cases.get(&row.job_id).copied().flatten()).transpose())
+        .filter_map(|row| job_record(row, packings.get(&row.job_id)).transpose())
         .collect::<Result<_, _>>()?;
     let options = SelectionOptions { threshold: args.threshold, folds: args.folds, seed: args.seed };
     let analysis = analyse(&records, &args.name, &options)?;
