@@ -163,8 +163,8 @@ const SIMULATED: [Simulated; 29] = [
 /// the paper's protocol: the table's domain, width, mass, shaking duration and size case;
 /// meshes keeping their own forms (§5.1: any library, the paper's being its 63 Rhine scans);
 /// no fluid forces; and every other value of the protocol and the evaluation at the paper's
-/// (`PackingSpec::paper`), the trim included. Only the seed, the domain height, the time limit
-/// and the meshes may differ.
+/// (`PackingSpec::paper`), the grid spacing and trim of its rules included. Only the seed, the
+/// domain height, the time limit and the meshes may differ.
 pub fn simulated_porosity(spec: &PackingSpec) -> Option<PaperPorosity> {
     let case = spec.grains.size.case()?.name;
     let kind = if spec.domain.is_periodic() { DomainKind::Periodic } else { DomainKind::Cylinder };
@@ -192,9 +192,12 @@ pub fn simulated_porosity(spec: &PackingSpec) -> Option<PaperPorosity> {
     papers.process.max_time = spec.process.max_time;
     papers.height = spec.height;
     papers.seed = spec.seed;
-    let trim = papers.derived().trim;
-    papers.trim = spec.trim;
-    (papers == *spec && spec.derived().trim == trim).then(|| PaperPorosity {
+    // A stored job names the spacing and trim that the paper's rules give (the stored form is
+    // concrete): compared as worked out, not as written.
+    let rules = papers.derived();
+    (papers.process.spacing, papers.trim) = (spec.process.spacing, spec.trim);
+    let derived = spec.derived();
+    (papers == *spec && (derived.spacing, derived.trim) == (rules.spacing, rules.trim)).then(|| PaperPorosity {
         table: row.table.to_string(),
         porosity: row.porosity,
         std: row.std,
@@ -246,15 +249,17 @@ mod tests {
         spec.seed = 7;
         spec.height = Some(0.5);
         spec.process.max_time = Some(20.0);
-        // The periodic trim is the largest sieve, 31.5 mm for U7 (§6.1: h^pd = 31.5 mm).
+        // The periodic trim is the largest sieve, 31.5 mm for U7 (§6.1: h^pd = 31.5 mm), and the
+        // grid spacing Table 3's h_g, 22 mm: stored jobs name both.
         spec.trim = Some(0.0315);
+        spec.process.spacing = Some(0.022);
         assert_eq!(found(&spec).map(|f| f.1), Some(0.291));
     }
 
     #[test]
     fn any_other_change_is_not_the_papers_setup() {
         type Change = (&'static str, fn(&mut PackingSpec));
-        let changes: [Change; 12] = [
+        let changes: [Change; 13] = [
             ("ellipsoids", |s| s.grains.shape = ShapeKind::Ellipsoid),
             ("one form", |s| s.grains.form = FormSpec::Single { fl: 0.6, el: 0.7 }),
             ("mass", |s| s.grains.mass = 4.5),
@@ -264,6 +269,7 @@ mod tests {
             ("a case the table lacks", |s| s.grains.size = TABLE3[0].sieve_curve()),
             ("time step", |s| s.time_step = 1e-5),
             ("damping", |s| s.process.damping = 1e-2),
+            ("grid spacing", |s| s.process.spacing = Some(0.03)),
             ("trim", |s| s.trim = Some(0.0)),
             ("slice", |s| s.slice = 2e-3),
             ("fluid", |s| {
