@@ -43,7 +43,7 @@ pub enum SelectionError {
     Threshold(f64),
     #[error("k-fold cross-validation needs k ≥ 2, got {0}")]
     Folds(usize),
-    #[error("{rows} finished jobs are too few to rank features and cross-validate a fit (at least 3)")]
+    #[error("too few finished jobs ({rows}) to rank features and cross-validate a fit (at least 3)")]
     TooFewRows { rows: usize },
     #[error("porosity is the same for every job, so no feature can be correlated with it")]
     ConstantPorosity,

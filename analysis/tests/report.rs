@@ -360,7 +360,7 @@ fn too_few_packings_still_give_a_report_that_says_why() {
     let out = tempfile::tempdir().unwrap();
     let files = report("tiny", &records, out.path());
     let md = std::fs::read_to_string(&files.markdown).unwrap();
-    assert!(md.contains("No model could be built: 2 finished jobs are too few"), "{md}");
+    assert!(md.contains("No model could be built: too few finished jobs (2) to rank features"), "{md}");
     assert!(files.models.is_empty());
     check_html(out.path(), 1);
 

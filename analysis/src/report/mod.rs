@@ -238,7 +238,7 @@ fn campaign_section(
     }
     if summary.failed + summary.pending + summary.running > 0 {
         blocks.push(Block::Paragraph(format!(
-            "Only the {} finished jobs enter the analysis; {} failed, {} are pending and {} running.",
+            "Only finished jobs enter the analysis ({} here); {} failed, {} are pending and {} running.",
             records.len(),
             summary.failed,
             summary.pending,
