@@ -6,7 +6,6 @@
 use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
-use solver::dem::Domain;
 use solver::packing::{DomainKind, FormSpec, GrainSpec, PackingSpec, ShapeKind};
 
 use crate::model::{CrossValidation, LinearModel};
@@ -177,10 +176,8 @@ pub fn simulated_porosity(spec: &PackingSpec) -> Option<PaperPorosity> {
             && same(s.shaking, spec.process.shaking_duration)
     })?;
     let mut papers = PackingSpec::paper(kind);
-    papers.domain = match kind {
-        DomainKind::Periodic => Domain::Periodic { width: spec.domain.width() },
-        DomainKind::Cylinder => Domain::Cylinder { diameter: spec.domain.width() },
-    };
+    // The row's kind is the spec's, and its width the spec's too.
+    papers.domain = spec.domain;
     papers.grains = GrainSpec {
         shape: ShapeKind::Mesh,
         size: spec.grains.size.clone(),
@@ -207,6 +204,7 @@ pub fn simulated_porosity(spec: &PackingSpec) -> Option<PaperPorosity> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use solver::dem::Domain;
     use solver::grain::TABLE3;
 
     /// The paper's protocol with meshes of their own forms, of `case` in a domain of `kind`.
