@@ -82,13 +82,16 @@ fn every_ready_campaign_file_reads_and_the_drag_study_pairs_its_seeds() {
 
 #[test]
 fn the_table_6_and_7_campaigns_are_the_papers_setups() {
-    // Every job of the two studies is the paper's setup, so that `sedpack report` compares it
-    // with the paper's row: Table 6 by size case in the cylinder, Table 7 at L = 0.1 m.
+    // Every job of these studies is the paper's setup, so that `sedpack report` compares it
+    // with the paper's row: Table 6 by size case in the cylinder, Table 7 at L = 0.1 m, and the
+    // pebbles' repeats of U1 and U7 (meshes of their own forms, as the scans).
     let table6 =
         [("U1", 0.383), ("U3", 0.369), ("U5", 0.333), ("U7", 0.314), ("B30", 0.286), ("B50", 0.280), ("B70", 0.290)];
     for (file, table, rows) in [
         ("campaigns/validation-cylinder.yaml", "Table 6", &table6[..]),
         ("campaigns/validation-periodic.yaml", "Table 7", &[("U7", 0.291), ("B50", 0.246)][..]),
+        ("campaigns/validation-pebbles.yaml", "Table 7", &[("U7", 0.291)][..]),
+        ("campaigns/validation-pebbles-cylinder.yaml", "Table 6", &[("U1", 0.383)][..]),
     ] {
         let campaign = sedpack::campaign::read_campaign(repo(file).as_ref()).unwrap();
         assert_eq!(campaign.jobs.len(), 3 * rows.len(), "{file}");
