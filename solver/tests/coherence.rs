@@ -3,12 +3,17 @@
 //! through generation, shaking (Eq. 14) and damping (§4.3). The shortcuts are the pairs skipped
 //! because their distance bound exceeds how far they may have moved, the polyhedron contacts
 //! confirmed from the last step's features, and the closed-form and clipped-cell centres of
-//! pressure; the full query is the cold GJK + EPA with the overlap clipped facet by facet.
+//! pressure; the full query is the cold GJK + EPA with the overlap clipped facet by facet. And
+//! the distance bound of a pair found apart, on two cubes falling side by side: only their
+//! relative motion uses it up.
 
 mod common;
 
-use common::small_bed_of as spec;
-use solver::dem::Audit;
+use common::{box_mesh, settings, small_bed_of as spec};
+use nalgebra::{UnitQuaternion, Vector3};
+use solver::dem::shape::Polyhedron;
+use solver::dem::{Audit, Domain, NewBody, Shape, Simulation};
+use solver::grain::TriMesh;
 use solver::grain::{MeshLibrary, RHINE_FORMS, UnitMesh, rhine_meshes};
 use solver::packing::{FormSpec, Packing, PackingSpec, Phase, ShapeKind};
 
@@ -65,4 +70,57 @@ fn ellipsoid_pairs_skipped_as_apart_never_touch() {
         // Ellipsoid contacts take no shortcut: warm or cold Newton ends at the same minimum.
         assert!(a.depth < 1e-12 && a.normal < 1e-8, "{name}: {a:?}");
     }
+}
+
+/// Two 1 cm cubes 1.0025 mm apart along x, falling at 3 m/s under gravity, the second also closing in
+/// on the first at `closing` m/s: the audit of each step until `steps` or their first contact,
+/// and the step of that contact.
+fn falling_cubes(closing: f64, steps: u64) -> (Audit, Option<u64>) {
+    let cube = || {
+        let (v, t) = box_mesh(0.01, 0.01, 0.01);
+        Shape::Polyhedron(Box::new(Polyhedron::from_mesh(&TriMesh::new(v, t).unwrap()).unwrap()))
+    };
+    let mut sim =
+        Simulation::new(Domain::Periodic { width: 0.1 }, settings(0.5, 0.5, Vector3::new(0.0, 0.0, -9.81))).unwrap();
+    for (x, vx) in [(0.04, 0.0), (0.0510025, -closing)] {
+        sim.add_body(NewBody {
+            shape: cube(),
+            position: Vector3::new(x, 0.05, 1.0),
+            orientation: UnitQuaternion::identity(),
+            velocity: Vector3::new(vx, 0.0, -3.0),
+            angular_velocity: Vector3::zeros(),
+        });
+    }
+    let mut audit = Audit::default();
+    for step in 0..steps {
+        let a = sim.audit_next_step().unwrap();
+        audit.merge(&a);
+        if a.contacts > 0 {
+            return (audit, Some(step));
+        }
+        sim.step().unwrap();
+    }
+    (audit, None)
+}
+
+#[test]
+fn grains_falling_together_keep_their_distance_bound() {
+    // 0.05 s of falling: each cube moves 16 cm, 160 times the gap, but not relative to the other,
+    // so after the first query the pair is skipped at every step. (A bound on each body's own
+    // travel would be used up every 33 steps: 2 × 3 m/s × 5 µs per step against 1 mm.)
+    let (a, contact) = falling_cubes(0.0, 10_000);
+    assert_eq!(contact, None);
+    assert_eq!((a.pairs, a.skipped, a.wrongly_skipped), (10_000, 9_999, 0), "{a:?}");
+}
+
+#[test]
+fn grains_closing_in_are_queried_in_time_to_meet() {
+    // Closing at 1 m/s, 5 µm per step, the 1.0025 mm gap is gone after 200.5 steps: the first
+    // contact is found after the 201st step, and no step before skips a touching pair.
+    let (a, contact) = falling_cubes(1.0, 1_000);
+    assert_eq!(a.wrongly_skipped, 0, "{a:?}");
+    assert_eq!(contact, Some(201), "{a:?}");
+    // The bound still skips most steps: each query finds the gap left, and the pair is skipped
+    // until its relative motion could have closed it.
+    assert!(a.skipped > 150, "{a:?}");
 }

@@ -23,10 +23,10 @@ pub struct Bodies {
     #[serde(with = "super::shape::table")]
     pub shape: Vec<Shape>,
     pub bounding_radius: Vec<f64>,
-    /// A bound on how far any point of the body has moved since it was created: the sum over
-    /// steps of (|v| + |ω| r) Δt, which lets a pair found apart be skipped until the two bodies'
-    /// bounds have grown by the gap between them ([`super::contact::coherence`]).
-    pub travel: Vec<f64>,
+    /// A bound on how far any point of the body has moved about its centre since it was
+    /// created: the sum over steps of |ω| r Δt. With the offset of two centres it bounds how far
+    /// a pair found apart can have closed in ([`super::contact::coherence`]).
+    pub turn: Vec<f64>,
 }
 
 /// The initial state of a new body.
@@ -58,7 +58,7 @@ impl Bodies {
         self.inertia.push(body.shape.principal_inertia(density));
         self.volume.push(volume);
         self.bounding_radius.push(body.shape.bounding_radius());
-        self.travel.push(0.0);
+        self.turn.push(0.0);
         self.shape.push(body.shape);
         self.len() - 1
     }

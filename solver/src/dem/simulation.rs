@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 
 use super::body::{Bodies, NewBody};
 use super::contact;
-use super::contact::{Mode, PairCache};
+use super::contact::{Mode, PairCache, Stance};
 use super::contact_law::{Calibration, ContactHistory, LinearSpringDashpot};
 use super::domain::Domain;
 use super::material::Material;
@@ -147,15 +147,15 @@ impl PairStage<'_> {
             let (ra, rb) = (bodies.bounding_radius[i], bodies.bounding_radius[j]);
             (contact::sphere::sphere_sphere(&xi, ra, &xj, rb)?, ra.min(rb))
         } else {
-            let travel = bodies.travel[i] + bodies.travel[j];
-            if cache.still_apart(travel) {
+            let now = Stance { offset: xj - xi, turn: bodies.turn[i] + bodies.turn[j] };
+            if cache.still_apart(&now) {
                 return None;
             }
             let [ka, kb] = pair.pieces.map(usize::from);
             let a = bodies.shape[i].piece(ka, xi, &bodies.orientation[i], &self.poses[i]);
             let b = bodies.shape[j].piece(kb, xj, &bodies.orientation[j], &self.poses[j]);
             let scale = a.smallest_half_extent().min(b.smallest_half_extent());
-            (contact::between(&a, &b, cache, travel, Mode::Coherent)?, scale)
+            (contact::between(&a, &b, cache, &now, Mode::Coherent)?, scale)
         };
         let arm_i = geometry.point - xi;
         let arm_j = geometry.point - xj;
@@ -412,16 +412,16 @@ impl Simulation {
             let [ka, kb] = pair.pieces.map(usize::from);
             let a = bodies.shape[i].piece(ka, xi, &bodies.orientation[i], &poses[i]);
             let b = bodies.shape[j].piece(kb, xj, &bodies.orientation[j], &poses[j]);
-            let travel = bodies.travel[i] + bodies.travel[j];
-            let full = contact::between(&a, &b, &mut PairCache::default(), travel, Mode::Full);
+            let now = Stance { offset: xj - xi, turn: bodies.turn[i] + bodies.turn[j] };
+            let full = contact::between(&a, &b, &mut PairCache::default(), &now, Mode::Full);
             audit.pairs += 1;
             let cache = self.neighbours.cache[k];
-            if cache.still_apart(travel) {
+            if cache.still_apart(&now) {
                 audit.skipped += 1;
                 audit.wrongly_skipped += usize::from(full.is_some());
                 continue;
             }
-            let fast = contact::between(&a, &b, &mut cache.clone(), travel, Mode::Coherent);
+            let fast = contact::between(&a, &b, &mut cache.clone(), &now, Mode::Coherent);
             let size = a.bounding_radius() + b.bounding_radius();
             match (full, fast) {
                 (Some(f), Some(c)) => {
@@ -494,12 +494,12 @@ impl Simulation {
             b.orientation.par_iter_mut(),
             b.velocity.par_iter_mut(),
             b.angular_velocity.par_iter_mut(),
-            b.travel.par_iter_mut(),
+            b.turn.par_iter_mut(),
             self.walls.par_iter_mut(),
         )
             .into_par_iter()
             .enumerate()
-            .map(|(k, (x, q, v, w, travel, walls))| {
+            .map(|(k, (x, q, v, w, turn, walls))| {
                 let shape = &b.shape[k];
                 let pose = &poses[k];
                 let mass = b.mass[k];
@@ -557,8 +557,8 @@ impl Simulation {
                     *w += q.transform_vector(&body_wdot) * dt;
                 }
                 *x += *v * dt;
-                // The centre moves by |v| Δt and the body turns by at most |ω| Δt (below).
-                *travel += (v.norm() + w.norm() * b.bounding_radius[k]) * dt;
+                // The body turns by at most |ω| Δt (below); its centre's motion is in each pair's offset.
+                *turn += w.norm() * b.bounding_radius[k] * dt;
                 // q ← q + ½ Δt (0, ω) q, exact to O((|ω|Δt)³) per step, then renormalised by one
                 // Newton step for 1/|q| about 1: |q|² − 1 is O((|ω|Δt)²), so the error is of
                 // its square, below round-off, and no square root or division is needed.
@@ -588,7 +588,7 @@ impl Simulation {
             + size_of_val(&b.volume[..])
             + size_of_val(&b.shape[..])
             + size_of_val(&b.bounding_radius[..])
-            + size_of_val(&b.travel[..]);
+            + size_of_val(&b.turn[..]);
         let shapes: usize = b.shape.iter().map(Shape::heap_bytes).sum();
         let walls: usize =
             self.walls.iter().map(|h| size_of_val(h) + h.capacity() * std::mem::size_of::<WallPoint>()).sum();

@@ -1,11 +1,14 @@
 //! Frame coherence: what a pair of pieces keeps from one time step to the next so that the
 //! narrow phase mostly confirms last step's answer instead of finding it again.
 //!
-//! * Apart: a lower bound g on the pieces' distance, with the sum T of the two bodies' travel
-//!   bounds when it was found (each body's travel bound grows every step by the most any of its
-//!   points can have moved, (|v| + |ω| r) Δt). While the travel sum has grown by less than g since,
-//!   the pieces cannot have met, and the pair is skipped without a query (as Bullet's
-//!   separating-distance utility does).
+//! * Apart: a lower bound g on the pieces' distance, with where the pair stood when it was
+//!   found ([`Stance`]): the offset d = x_B − x_A of the two bodies' centres and the sum of their
+//!   turns (each body's turn grows every step by the most any of its points can have moved about
+//!   its centre, |ω| r Δt). Moving B's centre relative to A's by Δd brings the pieces at most |Δd|
+//!   closer, and turning moves no point farther than the turn, so while |Δd| + Δturn < g the
+//!   pieces cannot have met and the pair is skipped without a query (Bullet's separating-distance
+//!   utility bounds the motion the same way). Only the relative motion counts: grains falling or
+//!   shaken together keep their bound however fast they go.
 //! * Touching polyhedra: the vertices of EPA's last face of K = A − B and of a point of K on the
 //!   far side. Next step the same vertex pairs, at the new poses, make a tetrahedron of K; if it
 //!   still holds the origin EPA starts from it and, when the contact's features have not
@@ -23,25 +26,36 @@ pub struct PairCache {
     /// A lower bound on the pieces' distance when it was last computed; 0 when unknown or in
     /// contact.
     pub gap: f64,
-    /// The two bodies' travel sum then.
-    pub travel: f64,
+    /// Where the pair stood then.
+    pub stance: Stance,
     pub features: Features,
 }
 
+/// Where a pair of bodies stands, as far as its distance bound needs.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Stance {
+    /// x_B − x_A, with B's periodic image.
+    pub offset: Vector3<f64>,
+    /// The sum of the two bodies' turns ([`crate::dem::Bodies::turn`]).
+    pub turn: f64,
+}
+
 impl PairCache {
-    /// Whether the pieces are still certainly apart now that the bodies' travel sum is `travel`.
+    /// Whether the pieces are still certainly apart, the pair standing as `now`.
     #[inline(always)]
-    pub fn still_apart(&self, travel: f64) -> bool {
-        travel - self.travel < self.gap
+    pub fn still_apart(&self, now: &Stance) -> bool {
+        let slack = self.gap - (now.turn - self.stance.turn);
+        slack > 0.0 && (now.offset - self.stance.offset).norm_squared() < slack * slack
     }
 
     /// Records a lower bound on the distance of two pieces of combined size `scale` (the sum of
-    /// their bounding radii) at travel sum `travel`, less a margin for the rounding of the bound
-    /// (relative to the coordinates, i.e. to `scale`) and of the travel sums.
+    /// their bounding radii), the pair standing as `now`, less a margin for rounding: 1e-12 of
+    /// `scale` holds the bound's (found relative to A's centre) and that of the offsets and turns
+    /// while they stay below a few hundred times `scale` (metres, for grains of millimetres).
     #[inline]
-    pub fn set_gap(&mut self, gap: f64, travel: f64, scale: f64) {
+    pub fn set_gap(&mut self, gap: f64, now: &Stance, scale: f64) {
         self.gap = (gap * (1.0 - 1e-9) - 1e-12 * scale).max(0.0);
-        self.travel = travel;
+        self.stance = *now;
     }
 }
 

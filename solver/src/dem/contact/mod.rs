@@ -16,7 +16,7 @@ pub mod support;
 
 use nalgebra::{Matrix3, Vector3};
 
-pub use self::coherence::PairCache;
+pub use self::coherence::{PairCache, Stance};
 use self::ellipsoid::EllipsoidPose;
 pub use self::manifold::Manifold;
 use self::polyhedron::Apart;
@@ -86,21 +86,21 @@ impl Piece<'_> {
 /// Contact of piece A with piece B. `cache` carries what the pair keeps from one step to the
 /// next ([`coherence`]): on entry its last contact normal or separating direction, on exit the
 /// one found now, so that both touching and merely close pairs start warm, and the distance
-/// bound of a pair found apart, recorded at the two bodies' travel sum `travel`. `mode` says
+/// bound of a pair found apart, recorded with where the pair stands `now`. `mode` says
 /// whether the polyhedron shortcuts may be taken.
 #[inline(always)]
-pub fn between(a: &Piece, b: &Piece, cache: &mut PairCache, travel: f64, mode: Mode) -> Option<ContactGeometry> {
+pub fn between(a: &Piece, b: &Piece, cache: &mut PairCache, now: &Stance, mode: Mode) -> Option<ContactGeometry> {
     match (a, b) {
         (Piece::Sphere { center: ca, radius: ra }, Piece::Sphere { center: cb, radius: rb }) => {
             sphere::sphere_sphere(ca, *ra, cb, *rb)
         }
-        _ => curved(a, b, cache, travel, mode),
+        _ => curved(a, b, cache, now, mode),
     }
 }
 
 /// The non-spherical pairs, kept out of line so that the sphere path stays small.
 #[inline(never)]
-fn curved(a: &Piece, b: &Piece, cache: &mut PairCache, travel: f64, mode: Mode) -> Option<ContactGeometry> {
+fn curved(a: &Piece, b: &Piece, cache: &mut PairCache, now: &Stance, mode: Mode) -> Option<ContactGeometry> {
     let start = (cache.warm != Vector3::zeros()).then_some(cache.warm);
     let flip = |c: ContactGeometry| ContactGeometry { normal: -c.normal, ..c };
     let flip_apart = |a: Apart| Apart { direction: -a.direction, ..a };
@@ -136,7 +136,7 @@ fn curved(a: &Piece, b: &Piece, cache: &mut PairCache, travel: f64, mode: Mode) 
         }
         None => {
             cache.warm = apart.direction;
-            cache.set_gap(apart.gap, travel, a.bounding_radius() + b.bounding_radius());
+            cache.set_gap(apart.gap, now, a.bounding_radius() + b.bounding_radius());
         }
     }
     contact
