@@ -9,11 +9,9 @@
 
 mod common;
 
-use common::{box_mesh, settings, small_bed_of as spec};
+use common::{box_shape, settings, small_bed_of as spec};
 use nalgebra::{UnitQuaternion, Vector3};
-use solver::dem::shape::Polyhedron;
-use solver::dem::{Audit, Domain, NewBody, Shape, Simulation};
-use solver::grain::TriMesh;
+use solver::dem::{Audit, Domain, NewBody, Simulation};
 use solver::grain::{MeshLibrary, RHINE_FORMS, UnitMesh, rhine_meshes};
 use solver::packing::{FormSpec, Packing, PackingSpec, Phase, ShapeKind};
 
@@ -72,19 +70,15 @@ fn ellipsoid_pairs_skipped_as_apart_never_touch() {
     }
 }
 
-/// Two 1 cm cubes 1.0025 mm apart along x, falling at 3 m/s under gravity, the second also closing in
-/// on the first at `closing` m/s: the audit of each step until `steps` or their first contact,
-/// and the step of that contact.
+/// Two 1 cm cubes 1.0025 mm apart along x, falling at 3 m/s under gravity, the second also
+/// closing in on the first at `closing` m/s: the audit of each step until `steps` or their first
+/// contact, and the step of that contact.
 fn falling_cubes(closing: f64, steps: u64) -> (Audit, Option<u64>) {
-    let cube = || {
-        let (v, t) = box_mesh(0.01, 0.01, 0.01);
-        Shape::Polyhedron(Box::new(Polyhedron::from_mesh(&TriMesh::new(v, t).unwrap()).unwrap()))
-    };
     let mut sim =
         Simulation::new(Domain::Periodic { width: 0.1 }, settings(0.5, 0.5, Vector3::new(0.0, 0.0, -9.81))).unwrap();
     for (x, vx) in [(0.04, 0.0), (0.0510025, -closing)] {
         sim.add_body(NewBody {
-            shape: cube(),
+            shape: box_shape(0.01, 0.01, 0.01),
             position: Vector3::new(x, 0.05, 1.0),
             orientation: UnitQuaternion::identity(),
             velocity: Vector3::new(vx, 0.0, -3.0),

@@ -4,21 +4,15 @@
 
 mod common;
 
-use common::{box_mesh, momenta, settings, slide_x};
+use common::{box_shape, momenta, settings, slide_x};
 use nalgebra::{UnitQuaternion, Vector3};
-use solver::dem::shape::Polyhedron;
 use solver::dem::{Domain, NewBody, Shape, Simulation};
-use solver::grain::{FormParameters, TriMesh, bonded_grain};
+use solver::grain::{FormParameters, bonded_grain};
 
 const G: f64 = 9.81;
 
 fn body(shape: Shape, position: Vector3<f64>, orientation: UnitQuaternion<f64>, velocity: Vector3<f64>) -> NewBody {
     NewBody { shape, position, orientation, velocity, angular_velocity: Vector3::zeros() }
-}
-
-fn cuboid(a: f64, b: f64, c: f64) -> Shape {
-    let (v, t) = box_mesh(a, b, c);
-    Shape::Polyhedron(Box::new(Polyhedron::from_mesh(&TriMesh::new(v, t).unwrap()).unwrap()))
 }
 
 /// A grain resting on the floor in `orientation` with its centre at `height`, under gravity
@@ -47,7 +41,7 @@ fn on_slope(
 fn a_cube_on_a_slope_sticks_or_slides_by_friction() {
     let g_eff = G * 1650.0 / 2650.0;
     let cube_on_slope =
-        |theta, time| on_slope(cuboid(0.01, 0.01, 0.01), UnitQuaternion::identity(), 0.005, theta, time);
+        |theta, time| on_slope(box_shape(0.01, 0.01, 0.01), UnitQuaternion::identity(), 0.005, theta, time);
     // Below the friction angle (tan⁻¹ μ = 26.57°) the cube is held by its contact's tangential
     // springs and, once settled, does not move: at 20° and at 26.5°, where its centre of
     // pressure sits near the downhill edge, it moves by less than 1 nm in 0.2 s (rounding). With
@@ -80,7 +74,7 @@ fn a_grain_resting_on_any_of_its_faces_neither_tips_nor_creeps() {
         (UnitQuaternion::from_axis_angle(&Vector3::y_axis(), -std::f64::consts::FRAC_PI_2), 0.005),
     ];
     for (k, (q, h)) in faces.into_iter().enumerate() {
-        let (dx, _, turn) = on_slope(cuboid(0.01, 0.006, 0.003), q, h, 10.0, 0.2);
+        let (dx, _, turn) = on_slope(box_shape(0.01, 0.006, 0.003), q, h, 10.0, 0.2);
         assert!(dx.abs() < 1e-9 && turn < 1e-9, "face {k}: moved {dx} m, turned {turn} rad");
     }
 }
@@ -93,7 +87,12 @@ fn a_cube_dropped_on_its_corner_comes_to_rest_on_a_face() {
     let tip = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), 3f64.to_radians());
     let mut sim =
         Simulation::new(Domain::Periodic { width: 0.1 }, settings(0.1, 0.5, Vector3::new(0.0, 0.0, -G))).unwrap();
-    sim.add_body(body(cuboid(0.01, 0.01, 0.01), Vector3::new(0.05, 0.05, 0.0095), tip * onto_corner, Vector3::zeros()));
+    sim.add_body(body(
+        box_shape(0.01, 0.01, 0.01),
+        Vector3::new(0.05, 0.05, 0.0095),
+        tip * onto_corner,
+        Vector3::zeros(),
+    ));
     for _ in 0..60_000 {
         sim.step().unwrap();
     }
@@ -210,7 +209,7 @@ fn the_horizontal_reach_of_a_turned_grain_is_its_widest_point_in_the_plane() {
             Vector3::new(sign(1) * a / 2.0, sign(2) * b / 2.0, sign(4) * c / 2.0)
         });
         let by_hand = corners.map(|v| horizontal(turn * v)).fold(0.0, f64::max);
-        let reach = cuboid(a, b, c).horizontal_reach(&turn);
+        let reach = box_shape(a, b, c).horizontal_reach(&turn);
         assert!((reach - by_hand).abs() < 1e-12, "box: {reach} vs {by_hand}");
 
         let semi_axes = Vector3::new(0.04, 0.015, 0.006);

@@ -15,14 +15,13 @@
 
 mod common;
 
-use common::{box_mesh, settings};
+use common::{box_shape, settings};
 use nalgebra::{UnitQuaternion, Vector3};
-use solver::dem::shape::Polyhedron;
 use solver::dem::{Domain, NewBody, Shape, Simulation};
 use solver::fabric::{Imbrication, imbrication};
 use solver::fluid::flow::Flow;
 use solver::fluid::{Fluid, FluidResponse, Scratch, WATER};
-use solver::grain::{FormParameters, TriMesh, bonded_grain};
+use solver::grain::{FormParameters, bonded_grain};
 
 /// Diameter of the rod's three spheres (m): a 12 × 4 × 4 mm rod of nominal diameter 5.8 mm.
 const D: f64 = 4e-3;
@@ -73,8 +72,7 @@ fn leaning(lean: Lean) -> Simulation {
     let top = foot + 2.0 * D * Vector3::new(s * dip.cos(), 0.0, dip.sin());
     // The edge under the top sphere, r sin(EDGE) beyond its centre, sets the slab's height.
     let (height, edge_x) = (top.z - r * edge.cos(), top.x + s * r * edge.sin());
-    let (v, t) = box_mesh(SLAB, SLAB, height);
-    let slab = Shape::Polyhedron(Box::new(Polyhedron::from_mesh(&TriMesh::new(v, t).unwrap()).unwrap()));
+    let slab = box_shape(SLAB, SLAB, height);
     let gravity = Vector3::new(0.0, 0.0, -9.81);
     let mut sim = Simulation::new(Domain::Periodic { width: 0.1 }, settings(0.1, 0.5, gravity)).unwrap();
     // The rod's long axis is its body x: turned about y by −s·dip its +x end rises to +s x.

@@ -5,6 +5,7 @@ use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 use rand::{Rng, RngExt};
 use serde::{Deserialize, Serialize};
 
+use super::contact::Stance;
 use super::shape::Shape;
 
 /// Position, orientation, velocities and mass properties of all grains.
@@ -61,6 +62,13 @@ impl Bodies {
         self.turn.push(0.0);
         self.shape.push(body.shape);
         self.len() - 1
+    }
+
+    /// Where the pair (i, j) stands for its distance bound, j's centre (with its periodic image)
+    /// lying at `offset` from i's.
+    #[inline(always)]
+    pub fn stance(&self, i: usize, j: usize, offset: Vector3<f64>) -> Stance {
+        Stance { offset, turn: self.turn[i] + self.turn[j] }
     }
 
     /// Velocity of the material point of body `b` at world point `p` (with `arm` = p − x_b).

@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 
 use super::body::{Bodies, NewBody};
 use super::contact;
-use super::contact::{Mode, PairCache, Stance};
+use super::contact::{Mode, PairCache};
 use super::contact_law::{Calibration, ContactHistory, LinearSpringDashpot};
 use super::domain::Domain;
 use super::material::Material;
@@ -147,7 +147,7 @@ impl PairStage<'_> {
             let (ra, rb) = (bodies.bounding_radius[i], bodies.bounding_radius[j]);
             (contact::sphere::sphere_sphere(&xi, ra, &xj, rb)?, ra.min(rb))
         } else {
-            let now = Stance { offset: xj - xi, turn: bodies.turn[i] + bodies.turn[j] };
+            let now = bodies.stance(i, j, xj - xi);
             if cache.still_apart(&now) {
                 return None;
             }
@@ -412,7 +412,7 @@ impl Simulation {
             let [ka, kb] = pair.pieces.map(usize::from);
             let a = bodies.shape[i].piece(ka, xi, &bodies.orientation[i], &poses[i]);
             let b = bodies.shape[j].piece(kb, xj, &bodies.orientation[j], &poses[j]);
-            let now = Stance { offset: xj - xi, turn: bodies.turn[i] + bodies.turn[j] };
+            let now = bodies.stance(i, j, xj - xi);
             let full = contact::between(&a, &b, &mut PairCache::default(), &now, Mode::Full);
             audit.pairs += 1;
             let cache = self.neighbours.cache[k];

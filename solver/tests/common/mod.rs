@@ -2,8 +2,9 @@
 #![allow(dead_code)]
 
 use nalgebra::Vector3;
-use solver::dem::{Calibration, Domain, Material, Settings, Simulation};
-use solver::grain::SieveCurve;
+use solver::dem::shape::Polyhedron;
+use solver::dem::{Calibration, Domain, Material, Settings, Shape, Simulation};
+use solver::grain::{SieveCurve, TriMesh};
 use solver::packing::{DomainKind, PackingSpec, ShapeKind};
 
 /// An axis-aligned box with sides (a, b, c) centred at the origin, outward normals, as
@@ -22,6 +23,12 @@ pub fn box_mesh(a: f64, b: f64, c: f64) -> (Vec<Vector3<f64>>, Vec<[u32; 3]>) {
         triangles.push([f[0], f[2], f[3]]);
     }
     (vertices, triangles)
+}
+
+/// The box of [`box_mesh`] as a polyhedron grain.
+pub fn box_shape(a: f64, b: f64, c: f64) -> Shape {
+    let (v, t) = box_mesh(a, b, c);
+    Shape::Polyhedron(Box::new(Polyhedron::from_mesh(&TriMesh::new(v, t).unwrap()).unwrap()))
 }
 
 /// A UV tessellation of the ellipsoid with semi-axes (a, b, c): `rings` latitude bands and
