@@ -132,7 +132,7 @@ fn pairs(g: &Grains) -> Vec<Pair> {
         pair.xb = m * (outside - 1e-3 * 0.5 * size);
         let (pa, pb) = pair.poses(g);
         let mut features = Features::default();
-        let Some(contact) = polyhedron_polyhedron_coherent(&pa, &pb, None, &mut features, Mode::Coherent).0 else {
+        let Some(contact) = polyhedron_polyhedron_coherent(&pa, &pb, None, 0.0, &mut features, Mode::Coherent).0 else {
             continue;
         };
         pair.previous_normal = contact.normal;
@@ -205,6 +205,7 @@ fn polyhedron_pairs(c: &mut Criterion) {
                         black_box(a),
                         black_box(b),
                         Some(n),
+                        0.0,
                         &mut features,
                         Mode::Coherent,
                     ));

@@ -534,29 +534,65 @@ fn tetrahedron_vertex_into_a_face() {
     assert!((c.point.z - tip.z).abs() < 1e-12);
 }
 
+/// Two random pebble hulls: A at a random place and turn, B at a random turn, to be placed along
+/// the random direction m.
+struct RandomPair {
+    sa: ConvexPolyhedron,
+    sb: ConvexPolyhedron,
+    center_a: V3,
+    turn_a: Matrix3<f64>,
+    turn_b: Matrix3<f64>,
+    m: V3,
+}
+
+impl RandomPair {
+    fn new(rng: &mut ChaCha8Rng) -> Self {
+        let (na, nb) = (rng.random_range(8..60), rng.random_range(8..60));
+        let (sa, sb) = (random_hull(rng, na), random_hull(rng, nb));
+        let center_a = V3::from_fn(|_, _| rng.random_range(-1.0..1.0));
+        let turn_a = random_rotation(rng);
+        Self { sa, sb, center_a, turn_a, turn_b: random_rotation(rng), m: random_unit(rng) }
+    }
+
+    fn a(&self) -> PolyhedronPose<'_> {
+        PolyhedronPose::new(&self.sa, self.center_a, &self.turn_a)
+    }
+
+    /// The distance of the centres along m at which the support planes along m meet.
+    fn reach(&self) -> f64 {
+        let a = self.a();
+        let reach_b =
+            self.sb.vertices().iter().map(|v| (self.turn_b * v).dot(&-self.m)).fold(f64::NEG_INFINITY, f64::max);
+        a.support(&self.m).dot(&self.m) - self.m.dot(a.center()) + reach_b
+    }
+
+    /// B with its centre `fraction` of the reach from A's along m.
+    fn b_at(&self, fraction: f64) -> PolyhedronPose<'_> {
+        PolyhedronPose::new(&self.sb, self.center_a + self.m * (fraction * self.reach()), &self.turn_b)
+    }
+}
+
 #[test]
 fn random_pairs_match_the_separating_axis_theorem_and_parry() {
     let mut rng = ChaCha8Rng::seed_from_u64(7);
     let (mut worst_depth, mut worst_normal, mut worst_parry, mut worst_point) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let (mut contacts, mut separated, mut compared_points, mut parry_off) = (0, 0, 0, 0);
     for _ in 0..400 {
-        let (na, nb) = (rng.random_range(8..60), rng.random_range(8..60));
-        let (sa, sb) = (random_hull(&mut rng, na), random_hull(&mut rng, nb));
-        let a = PolyhedronPose::new(&sa, V3::from_fn(|_, _| rng.random_range(-1.0..1.0)), &random_rotation(&mut rng));
-        let rb = random_rotation(&mut rng);
-        let m = random_unit(&mut rng);
-        let wa = World::of(&a);
-        let reach_a = wa.max_along(&m) - m.dot(a.center());
-        let reach_b = sb.vertices().iter().map(|v| (rb * v).dot(&-m)).fold(f64::NEG_INFINITY, f64::max);
+        let pair = RandomPair::new(&mut rng);
+        let a = pair.a();
         // Centre distances from deep overlap to clear separation along m.
-        let fraction = rng.random_range(0.2..1.1);
-        let b = PolyhedronPose::new(&sb, a.center() + m * (fraction * (reach_a + reach_b)), &rb);
-        let wb = World::of(&b);
+        let b = pair.b_at(rng.random_range(0.2..1.1));
+        let (wa, wb) = (World::of(&a), World::of(&b));
         let (depth, normal, second) = sat(&wa, &wb);
         let (contact, stats) = polyhedron_polyhedron_with_stats(&a, &b, None);
-        let parry =
-            parry3d_f64::query::contact(&parry_pose(&a), &parry_shape(&sa), &parry_pose(&b), &parry_shape(&sb), 0.0)
-                .unwrap();
+        let parry = parry3d_f64::query::contact(
+            &parry_pose(&a),
+            &parry_shape(&pair.sa),
+            &parry_pose(&b),
+            &parry_shape(&pair.sb),
+            0.0,
+        )
+        .unwrap();
         if depth.abs() < 1e-9 {
             continue;
         }
@@ -685,6 +721,65 @@ fn warm_starts_give_the_cold_answer_and_save_work() {
     );
     assert!(n > 100, "{n} contacts");
     assert!(warm_iterations < cold_iterations);
+}
+
+/// parry's distance between two placed polyhedra: the independent reference for distances.
+fn parry_distance(a: &PolyhedronPose, b: &PolyhedronPose) -> f64 {
+    parry3d_f64::query::distance(&parry_pose(a), &parry_shape(a.shape()), &parry_pose(b), &parry_shape(b.shape()))
+        .unwrap()
+        .distance
+}
+
+#[test]
+fn a_pair_still_apart_along_its_last_separating_direction_costs_one_query() {
+    // Pebble hulls found apart, then moved as in a step of the engine. Shifting B by s changes
+    // the bound −h_K(n) along the old direction n by n·s, and turning B by θ moves none of its
+    // points by more than θ r_B: with |s| ≤ 0.3 g and θ r_B ≤ 0.1 g, the old direction still
+    // gives at least 0.6 of the old bound g, above the half the engine keeps, so the query is one
+    // support query. Closing in by 0.8 g leaves 0.2 g along n, below half: the distance is found
+    // again. Every bound must lie below parry's distance (1e-9 for its rounding, on grains of
+    // size ~1) and, when found again, within the 5 % the separation query allows.
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let mut tested = 0;
+    for _ in 0..400 {
+        let pair = RandomPair::new(&mut rng);
+        let (sb, rb, reach) = (&pair.sb, pair.turn_b, pair.reach());
+        let a = pair.a();
+        // Support planes along m apart by 2–20 % of the reach: separated.
+        let b = pair.b_at(rng.random_range(1.02..1.2));
+        // Pairs whose bounding spheres stay apart are bounded by them, without a query.
+        if (b.center() - a.center()).norm() + 0.3 * reach > pair.sa.bounding_radius() + sb.bounding_radius() {
+            continue;
+        }
+        tested += 1;
+        let mut features = Features::default();
+        let (contact, first, _) = polyhedron_polyhedron_coherent(&a, &b, None, 0.0, &mut features, Mode::Coherent);
+        assert!(contact.is_none());
+        let d = parry_distance(&a, &b);
+        let g = first.gap;
+        assert!(g <= d + 1e-9 && g >= 0.95 * d - 1e-9, "bound {g} for distance {d}");
+
+        let shift = random_unit(&mut rng) * (rng.random_range(0.0..0.3) * g);
+        let turn = rotation(random_unit(&mut rng), 0.1 * g / sb.bounding_radius()) * rb;
+        let moved = PolyhedronPose::new(sb, b.center() + shift, &turn);
+        let (contact, apart, stats) =
+            polyhedron_polyhedron_coherent(&a, &moved, Some(&first.direction), g, &mut features, Mode::Coherent);
+        assert!(contact.is_none());
+        assert_eq!(stats.support_queries, 1);
+        // The same direction, normalised again.
+        assert!((apart.direction - first.direction).norm() < 1e-15, "{apart:?} {first:?}");
+        let d = parry_distance(&a, &moved);
+        assert!(apart.gap >= 0.6 * g - 1e-12 && apart.gap <= d + 1e-9, "bound {} of {g}, distance {d}", apart.gap);
+
+        let closer = PolyhedronPose::new(sb, b.center() - first.direction * (0.8 * g), &rb);
+        let (contact, apart, stats) =
+            polyhedron_polyhedron_coherent(&a, &closer, Some(&first.direction), g, &mut features, Mode::Coherent);
+        assert!(contact.is_none());
+        assert!(stats.support_queries > 1, "{stats:?}");
+        let d = parry_distance(&a, &closer);
+        assert!(apart.gap <= d + 1e-9 && apart.gap >= 0.95 * d - 1e-9, "bound {} for distance {d}", apart.gap);
+    }
+    assert!(tested > 100, "{tested} pairs");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -911,7 +1006,7 @@ fn the_engines_shortcuts_on_persisting_contacts_match_independent_references() {
         let depth = if k % 2 == 0 { 1e-3 } else { 1e-2 } * size;
         let b = PolyhedronPose::new(&sb, m * (outside - depth), &rb);
         let mut features = Features::default();
-        let Some(first) = polyhedron_polyhedron_coherent(&a, &b, None, &mut features, Mode::Coherent).0 else {
+        let Some(first) = polyhedron_polyhedron_coherent(&a, &b, None, 0.0, &mut features, Mode::Coherent).0 else {
             continue;
         };
         let turn = |r: &Matrix3<f64>, rng: &mut ChaCha8Rng| rotation(random_unit(rng), 1e-4) * r;
@@ -919,7 +1014,7 @@ fn the_engines_shortcuts_on_persisting_contacts_match_independent_references() {
         let a2 = PolyhedronPose::new(&sa, V3::zeros(), &ra2);
         let b2 = PolyhedronPose::new(&sb, b.center() + random_unit(&mut rng) * 1e-5 * size, &rb2);
         let (c, _, stats) =
-            polyhedron_polyhedron_coherent(&a2, &b2, Some(&first.normal), &mut features, Mode::Coherent);
+            polyhedron_polyhedron_coherent(&a2, &b2, Some(&first.normal), 0.0, &mut features, Mode::Coherent);
         let Some(c) = c else { continue };
         let (wa, wb) = (World::of(&a2), World::of(&b2));
         let (sat_depth, sat_normal, second) = sat(&wa, &wb);

@@ -8,7 +8,10 @@
 //!   closer, and turning moves no point farther than the turn, so while |Δd| + Δturn < g the
 //!   pieces cannot have met and the pair is skipped without a query (Bullet's separating-distance
 //!   utility bounds the motion the same way). Only the relative motion counts: grains falling or
-//!   shaken together keep their bound however fast they go.
+//!   shaken together keep their bound however fast they go. Once it is used up, the pair of
+//!   polyhedra is first tried along its last separating direction n: −h_K(n) is a new bound for
+//!   one support query, kept if it is at least half the last one (most near contacts of a bed,
+//!   requeried every few steps, end there); otherwise GJK finds the distance again.
 //! * Touching polyhedra: the vertices of EPA's last face of K = A − B and of a point of K on the
 //!   far side. Next step the same vertex pairs, at the new poses, make a tetrahedron of K; if it
 //!   still holds the origin EPA starts from it and, when the contact's features have not

@@ -242,7 +242,12 @@ pub(super) fn distance<A: Convex, B: Convex>(cso: &mut Cso<A, B>, start: &V3, bo
 pub(super) fn separation<A: Convex, B: Convex>(cso: &mut Cso<A, B>, u: &V3, tiny: f64) -> (f64, V3) {
     let Some(u) = unit(u) else { return (0.0, V3::zeros()) };
     let first = cso.support(&u);
-    let mut best = (-u.dot(&first.w), u);
+    separation_from(cso, &u, first, tiny)
+}
+
+/// [`separation`] from the unit direction `u` whose support point `first` is already known.
+pub(super) fn separation_from<A: Convex, B: Convex>(cso: &mut Cso<A, B>, u: &V3, first: Point, tiny: f64) -> (f64, V3) {
+    let mut best = (-u.dot(&first.w), *u);
     let mut simplex = Simplex::default();
     simplex.push(first);
     let mut v = first.w;

@@ -106,8 +106,14 @@ fn curved(a: &Piece, b: &Piece, cache: &mut PairCache, now: &Stance, mode: Mode)
     let flip_apart = |a: Apart| Apart { direction: -a.direction, ..a };
     let (contact, apart) = match (a, b) {
         (Piece::Polyhedron(pa), Piece::Polyhedron(pb)) => {
-            let (contact, apart, _) =
-                polyhedron::polyhedron_polyhedron_coherent(pa, pb, start.as_ref(), &mut cache.features, mode);
+            let (contact, apart, _) = polyhedron::polyhedron_polyhedron_coherent(
+                pa,
+                pb,
+                start.as_ref(),
+                cache.gap,
+                &mut cache.features,
+                mode,
+            );
             (contact, apart)
         }
         (Piece::Polyhedron(p), Piece::Sphere { center, radius }) => polyhedron::polyhedron_sphere(p, center, *radius),

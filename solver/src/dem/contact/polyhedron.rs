@@ -54,6 +54,9 @@ const POLISH_STEP: f64 = 1e-12;
 /// Relative to the pair's size (sum of bounding radii): distances below this count as zero
 /// (the origin on a simplex, or on ∂K: touching bodies).
 const TOUCHING: f64 = 1e-13;
+/// A pair found apart is taken to be still apart, without a new GJK distance query, while the
+/// bound along its last separating direction keeps this fraction of the last bound.
+const KEPT_GAP: f64 = 0.5;
 /// EPA stops when the support point along the nearest face's normal lies within this (relative)
 /// distance of that face: rounding for polyhedra...
 const GAP_POLYTOPE: f64 = 1e-12;
@@ -105,7 +108,7 @@ pub fn polyhedron_polyhedron_with_stats(
     warm_normal: Option<&V3>,
 ) -> (Option<ContactGeometry>, PolyhedronStats) {
     let mut features = Features::default();
-    let (contact, _, stats) = polyhedron_polyhedron_coherent(a, b, warm_normal, &mut features, Mode::Full);
+    let (contact, _, stats) = polyhedron_polyhedron_coherent(a, b, warm_normal, 0.0, &mut features, Mode::Full);
     (contact, stats)
 }
 
@@ -120,11 +123,13 @@ pub enum Mode {
 /// Contact of two polyhedra with frame coherence: `features` carries the last contact's
 /// features in and this one's out ([`super::coherence`]). Also returns, for a pair found apart,
 /// a lower bound on their distance (0 when touching or unknown), with the separating direction
-/// left in place of the contact normal as the next warm start.
+/// left in place of the contact normal as the next warm start. `last_gap` is the bound the last
+/// query found, with `warm_normal` its direction (0 if the pair was touching or is new).
 pub fn polyhedron_polyhedron_coherent(
     a: &PolyhedronPose,
     b: &PolyhedronPose,
     warm_normal: Option<&V3>,
+    last_gap: f64,
     features: &mut Features,
     mode: Mode,
 ) -> (Option<ContactGeometry>, Apart, PolyhedronStats) {
@@ -132,7 +137,7 @@ pub fn polyhedron_polyhedron_coherent(
     let (order, first, second) = if forward { (Order::Forward, a, b) } else { (Order::Swapped, b, a) };
     let warm = warm_normal.map(|n| if forward { *n } else { -n });
     let cached = (mode == Mode::Coherent && features.order == order).then_some(*features);
-    let (contact, apart, stats, kept) = solve_polyhedra(first, second, warm.as_ref(), cached, mode);
+    let (contact, apart, stats, kept) = solve_polyhedra(first, second, warm.as_ref(), last_gap, cached, mode);
     *features = kept.map_or(Features::default(), |(a, b)| Features { a, b, order });
     let flip = |c: ContactGeometry| if forward { c } else { ContactGeometry { normal: -c.normal, ..c } };
     let apart = Apart { direction: if forward { apart.direction } else { -apart.direction }, ..apart };
@@ -167,6 +172,7 @@ fn solve_polyhedra(
     a: &PolyhedronPose,
     b: &PolyhedronPose,
     warm_normal: Option<&V3>,
+    last_gap: f64,
     cached: Option<Features>,
     mode: Mode,
 ) -> (Option<ContactGeometry>, Apart, PolyhedronStats, Option<Kept>) {
@@ -199,7 +205,30 @@ fn solve_polyhedra(
             }
             cso
         }
-        None => Cso::new(a, b, &start),
+        None => {
+            let mut cso = Cso::new(a, b, &start);
+            if mode == Mode::Coherent && last_gap > 0.0 && warm_normal.and_then(unit).is_some() {
+                // n·d − h_A(n) − h_B(−n) = −h_K(n) bounds the distance for any unit n; along the
+                // last separating direction it stays close to the distance while the pair moves
+                // little, so a pair that is still clearly apart costs this one query, and one
+                // still apart along it needs no overlap test before its distance is sought.
+                let first = cso.support(&start);
+                let gap = -start.dot(&first.w);
+                let apart = if gap >= KEPT_GAP * last_gap {
+                    Some(Apart { gap, direction: start })
+                } else {
+                    (gap > tiny).then(|| {
+                        let (gap, direction) = gjk::separation_from(&mut cso, &start, first, tiny);
+                        Apart { gap, direction }
+                    })
+                };
+                if let Some(apart) = apart {
+                    stats.support_queries = cso.queries;
+                    return (None, apart, stats, None);
+                }
+            }
+            cso
+        }
     };
     if end.is_none() {
         end = match gjk::overlap(&mut cso, &start, tiny, &mut stats.gjk_iterations) {
