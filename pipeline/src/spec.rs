@@ -28,6 +28,22 @@ pub struct JobSpec {
     pub experiment: Option<Experiment>,
 }
 
+impl JobSpec {
+    /// Why the packing will likely end in "too thin for the trim", if it will: the bed expected
+    /// from the mass is no higher than the two trims of the porosity evaluation (§4.4) together.
+    pub fn thin_bed(&self) -> Option<String> {
+        let p = &self.packing;
+        let (bed, trim) = (p.expected_bed_height(), p.derived().trim);
+        let whose = if p.trim.is_some() { "" } else { " (the largest sieve, the paper's trim of the periodic domain)" };
+        (2.0 * trim >= bed).then(|| {
+            format!(
+                "{}: grains.mass makes a bed about {bed:.4} m high (at porosity 0.4), and the porosity is evaluated from evaluation.trim = {trim} m{whose} above the floor to as far below the surface: the packing will likely end with \"too thin for the trim\"; give more mass or a smaller evaluation.trim",
+                self.name
+            )
+        })
+    }
+}
+
 /// Reads, parses and resolves a job file.
 pub fn read_job(path: &Path) -> anyhow::Result<JobSpec> {
     let (text, file) = read_job_file(path)?;

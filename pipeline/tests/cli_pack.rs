@@ -24,6 +24,8 @@ fn pack_writes_consistent_outputs_that_the_porosity_command_confirms() {
     let out = dir.path().join("out");
     let run = sedpack(&["pack", &job, "--out", out.to_str().unwrap(), "--json"]);
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    // 0.1 kg over 0.04 m × 0.04 m is a bed of ~39 mm at porosity 0.4, above the 2 × 8 mm trims.
+    assert!(!String::from_utf8_lossy(&run.stderr).contains("warning"), "{}", String::from_utf8_lossy(&run.stderr));
     let printed: Value = serde_json::from_slice(&run.stdout).unwrap();
     let file: Value = serde_json::from_str(&std::fs::read_to_string(out.join("result.json")).unwrap()).unwrap();
     assert_eq!(printed, file);
@@ -57,6 +59,24 @@ fn pack_writes_consistent_outputs_that_the_porosity_command_confirms() {
     assert_eq!(profile.lines().count() - 1, file["profile"].as_array().unwrap().len());
     let vtk = std::fs::read(out.join("packing.vtk")).unwrap();
     assert!(vtk.starts_with(b"# vtk DataFile Version 3.0\n"));
+}
+
+#[test]
+fn a_bed_too_thin_for_its_trims_is_announced_before_it_is_packed() {
+    // 20 g of 5.6–8 mm spheres over 0.04 m × 0.04 m: a bed of 0.02 / (2650 × 0.0016 × 0.6) =
+    // 7.9 mm at porosity 0.4, under the two trims of 8 mm (the largest sieve). The warning
+    // comes first, and the packing still ends with the evaluation's error.
+    let dir = tempfile::tempdir().unwrap();
+    let job = write(dir.path(), "thin.yaml", &SMALL_BED.replace("mass: 0.1", "mass: 0.02"));
+    let run = sedpack(&["pack", &job, "--out", dir.path().join("out").to_str().unwrap()]);
+    assert!(!run.status.success());
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    let warning = stderr.find("sedpack: warning: ").expect("a warning");
+    let error = stderr.find("too thin for the trim of 0.008 m").expect("the evaluation's error");
+    assert!(warning < error, "{stderr}");
+    for part in ["thin.yaml", "about 0.0079 m high", "evaluation.trim = 0.008 m (the largest sieve"] {
+        assert!(stderr[warning..error].contains(part), "{part}: {stderr}");
+    }
 }
 
 #[test]

@@ -103,6 +103,11 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     .checked_flags()?;
     let interval = checkpoint_interval(args.common.checkpoint_interval)?;
     let campaign = read_campaign(&args.campaign)?;
+    let thin: Vec<String> = campaign.jobs.iter().filter_map(|j| j.spec.thin_bed()).collect();
+    if let Some(first) = thin.first() {
+        let more = if thin.len() > 1 { format!(" (and {} more job(s) alike)", thin.len() - 1) } else { String::new() };
+        eprintln!("sedpack: warning: {}: {first}{more}", args.campaign.display());
+    }
     let log = start_log(&args.db)?;
     runtime()?.block_on(async {
         let store = Store::open(&args.db).await?;

@@ -47,6 +47,9 @@ pub fn run(args: &PackArgs) -> anyhow::Result<()> {
         bail!("--threads must be at least 1");
     }
     let job = read_job(&args.job)?;
+    if let Some(warning) = job.thin_bed() {
+        eprintln!("sedpack: warning: {}: {warning}", args.job.display());
+    }
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from(&job.name));
     let mut packing = Packing::new(job.packing.clone()).with_context(|| format!("{}", args.job.display()))?;
     let bar = progress_bar(args.json);

@@ -204,13 +204,19 @@ impl PackingSpec {
         }
     }
 
+    /// Height of the finished bed (m) if its porosity is 0.4: the grains' volume over
+    /// (1 − 0.4) times the cross-section.
+    pub fn expected_bed_height(&self) -> f64 {
+        self.grains.mass / (self.material.density * self.domain.cross_section() * 0.6)
+    }
+
     /// The values this spec leaves to the paper's rules, worked out from the others.
     pub fn derived(&self) -> Derived {
         let size = &self.grains.size;
         let spacing = self.process.spacing.unwrap_or_else(|| size.case().map_or(size.largest_in_use(), |c| c.spacing));
-        // The generation region [0.6, 1]·H must clear the finished bed (estimated at porosity
-        // 0.4) by two grid spacings, so that sets can always leave it.
-        let bed = self.grains.mass / (self.material.density * self.domain.cross_section() * 0.6);
+        // The generation region [0.6, 1]·H must clear the finished bed by two grid spacings, so
+        // that sets can always leave it.
+        let bed = self.expected_bed_height();
         let height = self.height.unwrap_or_else(|| ((bed + 2.0 * spacing) / 0.6 * 100.0).ceil() / 100.0);
         // Generation plus settling rarely takes more than a minute of simulated time.
         let max_time = self.process.max_time.unwrap_or(self.process.shaking_duration + 60.0);
