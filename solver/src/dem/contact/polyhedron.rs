@@ -185,7 +185,8 @@ fn solve_polyhedra(
     }
     let tiny = TOUCHING * reach;
     let (polytope_gap, visible) = (GAP_POLYTOPE * reach, VISIBLE * reach);
-    let start = warm_normal.and_then(unit).or_else(|| unit(&d)).unwrap_or_else(V3::z);
+    let warm = warm_normal.and_then(unit);
+    let start = warm.or_else(|| unit(&d)).unwrap_or_else(V3::z);
     let mut far = None;
     let mut end = None;
     let mut cso = match cached.map(|f| warm_tetrahedron(a, b, &d, &f)) {
@@ -207,7 +208,7 @@ fn solve_polyhedra(
         }
         None => {
             let mut cso = Cso::new(a, b, &start);
-            if mode == Mode::Coherent && last_gap > 0.0 && warm_normal.and_then(unit).is_some() {
+            if mode == Mode::Coherent && last_gap > 0.0 && warm.is_some() {
                 // n·d − h_A(n) − h_B(−n) = −h_K(n) bounds the distance for any unit n; along the
                 // last separating direction it stays close to the distance while the pair moves
                 // little, so a pair that is still clearly apart costs this one query, and one
