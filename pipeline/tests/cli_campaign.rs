@@ -7,7 +7,7 @@ use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-use common::{fails, json, ok, path_in, sphere_campaign, write};
+use common::{fails, json, ok, path_in, sedpack, sphere_campaign, write};
 use store::{ExportRow, JobState, Store};
 
 /// A 2 × 2 grid of sphere packings of ~60 grains; `shaking` sets how long each runs.
@@ -290,6 +290,35 @@ fn failing_jobs_are_recorded_and_retried_on_request() {
     assert!(status["failures"][0]["error"].as_str().unwrap().contains("solver.max_time = 0.02"));
     let retried = ok(&["run", &file, "--db", db, "--retry-failed", "--quiet"]);
     assert!(retried.contains("1 failed job(s) returned to pending") && retried.contains("1 failed now"), "{retried}");
+}
+
+#[test]
+fn a_campaign_with_beds_too_thin_for_their_trims_says_so_before_it_runs() {
+    // 30 g of spheres over 3 cm × 3 cm make a bed of 0.03 / (2650 × 0.0009 × 0.6) = 0.021 m at
+    // porosity 0.4: trims of 0.004 m leave 0.013 m to evaluate, trims of 0.012 m and 0.015 m
+    // (twice that: 0.024 m and 0.030 m) nothing. One warning names the file and the first thin
+    // job and counts the other; the two thin jobs then fail with the evaluation's error.
+    let dir = tempfile::tempdir().unwrap();
+    let text = sphere_campaign("thin", 0.05, "grid:\n  evaluation.trim: [0.004, 0.012, 0.015]\n");
+    let file = write(dir.path(), "thin.yaml", &text);
+    let db = &path_in(dir.path(), "t.db");
+    let run = sedpack(&["run", &file, "--db", db, "--quiet"]);
+    let (stdout, stderr) = (String::from_utf8_lossy(&run.stdout), String::from_utf8_lossy(&run.stderr));
+    assert!(run.status.success(), "{stderr}");
+    let warnings: Vec<&str> = stderr.lines().filter(|l| l.starts_with("sedpack: warning: ")).collect();
+    assert_eq!(warnings.len(), 1, "{stderr}");
+    for part in ["thin.yaml", "about 0.0210 m high", "evaluation.trim = 0.012 m", "(and 1 more job(s) alike)"] {
+        assert!(warnings[0].contains(part), "{part}: {stderr}");
+    }
+    assert!(stdout.contains("1 job(s) finished now, 2 failed now"), "{stdout}");
+    let status = json(&["status", "thin", "--db", db, "--json"]);
+    let failures = status["failures"].as_array().unwrap();
+    assert_eq!(failures.len(), 2, "{status}");
+    assert!(failures.iter().all(|f| f["error"].as_str().unwrap().contains("too thin for the trim")), "{status}");
+    // The same campaign without the thin jobs warns of nothing.
+    let fine = write(dir.path(), "fine.yaml", &text.replace("[0.004, 0.012, 0.015]", "[0.004]"));
+    let run = sedpack(&["run", &fine, "--db", db, "--quiet"]);
+    assert!(run.status.success() && !String::from_utf8_lossy(&run.stderr).contains("warning"));
 }
 
 #[test]
