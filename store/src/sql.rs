@@ -108,7 +108,8 @@ pub const STATUS_COUNTS: &str = "
            COUNT(*) FILTER (WHERE jobs.state = 'done'),
            COUNT(*) FILTER (WHERE jobs.state = 'failed'),
            TOTAL(COALESCE(results.wall_time, jobs.wall_time)) FILTER (WHERE jobs.state IN ('done', 'failed')),
-           AVG(COALESCE(results.wall_time, jobs.wall_time)) FILTER (WHERE jobs.state = 'done')
+           AVG(COALESCE(results.wall_time, jobs.wall_time)) FILTER (WHERE jobs.state = 'done'),
+           AVG(results.simulated_time) FILTER (WHERE jobs.state = 'done')
     FROM jobs LEFT JOIN results ON results.job_id = jobs.id WHERE jobs.campaign_id = ?1";
 pub const IN_PROGRESS: &str = "
     SELECT jobs.id, jobs.state, jobs.worker_id, jobs.attempts, jobs.started_at,

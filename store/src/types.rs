@@ -163,6 +163,8 @@ pub struct CampaignStatus {
     pub wall_time_finished: f64,
     /// s per done job (its packing time over all attempts), None before the first one is done.
     pub mean_wall_time_done: Option<f64>,
+    /// s of simulated time per done job, None before the first one is done.
+    pub mean_simulated_time_done: Option<f64>,
     /// The running jobs and the pending ones with a checkpoint, in submission order.
     pub in_progress: Vec<Progress>,
 }

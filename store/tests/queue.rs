@@ -245,7 +245,7 @@ async fn status_counts_states_and_times_finished_jobs() {
     let _running = store.claim(CAMPAIGN, "w4").await.unwrap().unwrap();
     tokio::time::sleep(Duration::from_millis(300)).await;
     store.complete(&done_a.id, "w1", &result(0.37), &[]).await.unwrap();
-    store.complete(&done_b.id, "w2", &result(0.39), &[]).await.unwrap();
+    store.complete(&done_b.id, "w2", &JobResult { simulated_time: 8.5, ..result(0.39) }, &[]).await.unwrap();
     store.fail(&failed.id, "w3", "bad mesh").await.unwrap();
 
     let status = store.status(CAMPAIGN).await.unwrap();
@@ -254,6 +254,8 @@ async fn status_counts_states_and_times_finished_jobs() {
     // Done jobs count their packing's own time (the results say 42 s each, however long the
     // last attempt took); the failed job its last attempt (0.3 s or a little more).
     assert_eq!(status.mean_wall_time_done, Some(42.0));
+    // Their simulated times, 7.5 s and 8.5 s, average to 8 s; the failed job has none.
+    assert_eq!((empty.mean_simulated_time_done, status.mean_simulated_time_done), (None, Some(8.0)));
     assert!((84.3..94.0).contains(&status.wall_time_finished), "{status:?}");
     let json = serde_json::to_value(&status).unwrap();
     for key in ["campaign", "jobs", "pending", "running", "done", "failed"] {

@@ -346,7 +346,7 @@ pub(crate) async fn catch_up(store: &Store, db: &Path, name: &str) -> anyhow::Re
 struct StatusRecord {
     #[serde(flatten)]
     status: CampaignStatus,
-    /// Pending and running jobs times the mean wall time of a finished job, for one worker (s).
+    /// Wall time left for one worker (s), by [`time_left`].
     estimated_time_left: Option<f64>,
     executor: Executor,
     /// A Slurm campaign's jobs beside their tasks' states in Slurm.
@@ -357,12 +357,22 @@ struct StatusRecord {
 async fn status_record(store: &Store, db: &Path, name: &str) -> anyhow::Result<StatusRecord> {
     let caught_up = catch_up(store, db, name).await?;
     let status = store.status(name).await?;
-    let left = status.mean_wall_time_done.map(|m| m * (status.pending + status.running) as f64);
+    let left = time_left(&status);
     let (executor, tasks) = match caught_up {
         None => (Executor::Local, None),
         Some((executor, run)) => (executor, Some(slurm::task_rows(store, &run, name).await?)),
     };
     Ok(StatusRecord { status, estimated_time_left: left, executor, tasks })
+}
+
+/// Wall time left for one worker (s): a done job's mean wall time for every pending or running
+/// job, less, for each with a checkpoint, the share of a done job's mean simulated time that its
+/// checkpoint has already simulated (at most all of it). None before a job is done.
+fn time_left(s: &CampaignStatus) -> Option<f64> {
+    let wall = s.mean_wall_time_done?;
+    let simulated = s.mean_simulated_time_done.filter(|&t| t > 0.0);
+    let covered: f64 = s.in_progress.iter().filter_map(|p| Some((p.checkpoint?.0 / simulated?).min(1.0))).sum();
+    Some(wall * ((s.pending + s.running) as f64 - covered).max(0.0))
 }
 
 pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
@@ -399,8 +409,13 @@ pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
                     ),
                 )
                 .row("time spent", format!("{} on finished jobs", duration(s.wall_time_finished)));
-            if let Some(left) = r.estimated_time_left {
-                table.row("time left", format!("≈ {} for one worker", duration(left)));
+            if let (Some(left), Some(wall)) = (r.estimated_time_left, s.mean_wall_time_done) {
+                let simulated =
+                    s.mean_simulated_time_done.map(|t| format!(" for {t:.2} s simulated")).unwrap_or_default();
+                table.row(
+                    "time left",
+                    format!("≈ {} for one worker (a done job took {}{simulated})", duration(left), duration(wall)),
+                );
             }
             for f in &s.failures {
                 table.row(format!("failed {}", f.job_id), f.error.clone());
@@ -567,6 +582,41 @@ mod tests {
             progress_text(&stopped, 2810.0),
             "pending; checkpoint at 1.90 s simulated, 10.0 s ago: `resume` continues from it"
         );
+    }
+
+    #[test]
+    fn the_time_left_counts_what_the_checkpoints_have_already_simulated() {
+        // Done jobs took 100 s of wall time for 2 s simulated on average. Left: one pending job
+        // without a checkpoint (100 s), one running at 1.5 s (a quarter left: 25 s) and one
+        // pending at 2.5 s, past the mean (nothing counted): 125 s.
+        let job = |state, simulated: Option<f64>| Progress {
+            job_id: "a".into(),
+            state,
+            worker_id: None,
+            attempts: 1,
+            started_at: None,
+            checkpoint: simulated.map(|t| (t, 0.0)),
+            stage: None,
+        };
+        let mut status = CampaignStatus {
+            campaign: "c".into(),
+            jobs: 5,
+            pending: 2,
+            running: 1,
+            done: 2,
+            failed: 0,
+            failures: vec![],
+            wall_time_finished: 200.0,
+            mean_wall_time_done: Some(100.0),
+            mean_simulated_time_done: Some(2.0),
+            in_progress: vec![job(JobState::Running, Some(1.5)), job(JobState::Pending, Some(2.5))],
+        };
+        assert_eq!(time_left(&status), Some(125.0));
+        // Without a done job's simulated time, checkpoints cannot be weighed: every job counts whole.
+        status.mean_simulated_time_done = None;
+        assert_eq!(time_left(&status), Some(300.0));
+        status.mean_wall_time_done = None;
+        assert_eq!(time_left(&status), None);
     }
 
     #[test]
