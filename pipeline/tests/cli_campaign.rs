@@ -214,7 +214,8 @@ fn a_killed_runner_resumes_from_its_checkpoint_with_identical_results() {
         rows(db, "killed").into_iter().filter(|r| r.state == JobState::Running).map(|r| r.job_id).collect();
     assert_eq!(running.len(), 1, "the killed runner left its job running");
     // `status` says where that job stands: running, with the checkpoint it will resume from.
-    let in_progress = &json(&["status", "killed", "--db", db, "--json"])["in_progress"];
+    let status = json(&["status", "killed", "--db", db, "--json"]);
+    let in_progress = &status["in_progress"];
     assert_eq!(in_progress.as_array().map(|a| a.len()), Some(1), "{in_progress}");
     assert_eq!(
         (in_progress[0]["job_id"].as_str(), in_progress[0]["state"].as_str()),
@@ -224,9 +225,18 @@ fn a_killed_runner_resumes_from_its_checkpoint_with_identical_results() {
     assert!(simulated > 0.0, "{in_progress}");
     let text = ok(&["status", "killed", "--db", db]);
     assert!(text.contains(&format!("checkpoint at {simulated:.2} s simulated")), "{text}");
+    // The time left: a done job's wall time for each of the jobs left, less the share of a done
+    // job's simulated time that the running one's checkpoint covers.
+    let field = |key: &str| status[key].as_f64().unwrap_or_else(|| panic!("{key}: {status}"));
+    let left = (field("pending") + field("running") - (simulated / field("mean_simulated_time_done")).min(1.0))
+        * field("mean_wall_time_done");
+    assert!((field("estimated_time_left") - left).abs() <= 1e-9 * left, "{status}");
+    assert!(text.contains("time left") && text.contains(" s simulated)"), "{text}");
 
     let resumed = ok(&["resume", "killed", "--db", db, "--quiet"]);
     assert!(resumed.contains("4 done"), "{resumed}");
+    let text = ok(&["status", "killed", "--db", db]);
+    assert!(!text.contains("time left"), "nothing is left: {text}");
     assert_eq!(porosities(db, "killed"), reference, "identical results, bit for bit");
     for row in rows(db, "killed") {
         assert_eq!(row.state, JobState::Done);

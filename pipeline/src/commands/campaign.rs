@@ -409,7 +409,8 @@ pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
                     ),
                 )
                 .row("time spent", format!("{} on finished jobs", duration(s.wall_time_finished)));
-            if let (Some(left), Some(wall)) = (r.estimated_time_left, s.mean_wall_time_done) {
+            let unfinished = s.pending + s.running > 0;
+            if let (Some(left), Some(wall), true) = (r.estimated_time_left, s.mean_wall_time_done, unfinished) {
                 let simulated =
                     s.mean_simulated_time_done.map(|t| format!(" for {t:.2} s simulated")).unwrap_or_default();
                 table.row(
