@@ -375,6 +375,27 @@ fn time_left(s: &CampaignStatus) -> Option<f64> {
     Some(wall * ((s.pending + s.running) as f64 - covered).max(0.0))
 }
 
+/// The time left in words, with what it is based on and the jobs it cannot weigh (those that
+/// have simulated more than a done job count as ending now); None once every job has ended.
+fn time_left_text(s: &CampaignStatus) -> Option<String> {
+    let (left, wall) = (time_left(s)?, s.mean_wall_time_done?);
+    if s.pending + s.running == 0 {
+        return None;
+    }
+    let (simulated, past) = match s.mean_simulated_time_done {
+        Some(mean) => (
+            format!(" for {mean:.2} s simulated"),
+            s.in_progress.iter().filter(|p| p.checkpoint.is_some_and(|c| c.0 >= mean)).count(),
+        ),
+        None => (String::new(), 0),
+    };
+    let past = match past {
+        0 => String::new(),
+        k => format!("; {k} job(s) already past that, whose end is not estimated"),
+    };
+    Some(format!("≈ {} for one worker (a done job took {}{simulated}){past}", duration(left), duration(wall)))
+}
+
 pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
     runtime()?.block_on(async {
         let store = open_existing(&args.db).await?;
@@ -409,14 +430,8 @@ pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
                     ),
                 )
                 .row("time spent", format!("{} on finished jobs", duration(s.wall_time_finished)));
-            let unfinished = s.pending + s.running > 0;
-            if let (Some(left), Some(wall), true) = (r.estimated_time_left, s.mean_wall_time_done, unfinished) {
-                let simulated =
-                    s.mean_simulated_time_done.map(|t| format!(" for {t:.2} s simulated")).unwrap_or_default();
-                table.row(
-                    "time left",
-                    format!("≈ {} for one worker (a done job took {}{simulated})", duration(left), duration(wall)),
-                );
+            if let Some(text) = time_left_text(s) {
+                table.row("time left", text);
             }
             for f in &s.failures {
                 table.row(format!("failed {}", f.job_id), f.error.clone());
@@ -613,9 +628,23 @@ mod tests {
             in_progress: vec![job(JobState::Running, Some(1.5)), job(JobState::Pending, Some(2.5))],
         };
         assert_eq!(time_left(&status), Some(125.0));
+        assert_eq!(
+            time_left_text(&status).as_deref(),
+            Some(
+                "≈ 2 min 05 s for one worker (a done job took 1 min 40 s for 2.00 s simulated); 1 job(s) already \
+                 past that, whose end is not estimated"
+            )
+        );
         // Without a done job's simulated time, checkpoints cannot be weighed: every job counts whole.
         status.mean_simulated_time_done = None;
         assert_eq!(time_left(&status), Some(300.0));
+        assert_eq!(
+            time_left_text(&status).as_deref(),
+            Some("≈ 5 min 00 s for one worker (a done job took 1 min 40 s)")
+        );
+        // Nothing left to run: no estimate to print.
+        let ended = CampaignStatus { pending: 0, running: 0, in_progress: vec![], ..status.clone() };
+        assert_eq!(time_left_text(&ended), None);
         status.mean_wall_time_done = None;
         assert_eq!(time_left(&status), None);
     }
