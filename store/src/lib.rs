@@ -451,7 +451,10 @@ impl Store {
         let mut tx = self.pool.begin().await.map_err(self.db())?;
         let campaign_id = self.campaign_id(&mut tx, campaign).await?;
         type Counts = (u64, u64, u64, u64, u64, f64, Option<f64>, Option<f64>);
-        let (jobs, pending, running, done, failed, wall_time_finished, mean_wall_time_done, mean_simulated_time_done): Counts = sqlx::query_as(sql::STATUS_COUNTS).bind(campaign_id).fetch_one(&mut *tx).await.map_err(self.db())?;
+        let counts: Counts =
+            sqlx::query_as(sql::STATUS_COUNTS).bind(campaign_id).fetch_one(&mut *tx).await.map_err(self.db())?;
+        let (jobs, pending, running, done, failed, wall_time_finished, mean_wall_time_done, mean_simulated_time_done) =
+            counts;
         let failures: Vec<(String, u32, String)> =
             sqlx::query_as(sql::FAILURES).bind(campaign_id).fetch_all(&mut *tx).await.map_err(self.db())?;
         type ProgressRow = (

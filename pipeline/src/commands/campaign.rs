@@ -365,13 +365,19 @@ async fn status_record(store: &Store, db: &Path, name: &str) -> anyhow::Result<S
     Ok(StatusRecord { status, estimated_time_left: left, executor, tasks })
 }
 
+/// The share of a done job's mean simulated time that each checkpoint of a job in progress has
+/// already simulated (above 1 for a job past it); none before a done job's simulated time is known.
+fn simulated_shares(s: &CampaignStatus) -> impl Iterator<Item = f64> + '_ {
+    let mean = s.mean_simulated_time_done.filter(|&t| t > 0.0);
+    s.in_progress.iter().filter_map(move |p| Some(p.checkpoint?.0 / mean?))
+}
+
 /// Wall time left for one worker (s): a done job's mean wall time for every pending or running
-/// job, less, for each with a checkpoint, the share of a done job's mean simulated time that its
-/// checkpoint has already simulated (at most all of it). None before a job is done.
+/// job, less, for each with a checkpoint, its simulated share (at most all of it). None before a
+/// job is done.
 fn time_left(s: &CampaignStatus) -> Option<f64> {
     let wall = s.mean_wall_time_done?;
-    let simulated = s.mean_simulated_time_done.filter(|&t| t > 0.0);
-    let covered: f64 = s.in_progress.iter().filter_map(|p| Some((p.checkpoint?.0 / simulated?).min(1.0))).sum();
+    let covered: f64 = simulated_shares(s).map(|share| share.min(1.0)).sum();
     Some(wall * ((s.pending + s.running) as f64 - covered).max(0.0))
 }
 
@@ -382,14 +388,8 @@ fn time_left_text(s: &CampaignStatus) -> Option<String> {
     if s.pending + s.running == 0 {
         return None;
     }
-    let (simulated, past) = match s.mean_simulated_time_done {
-        Some(mean) => (
-            format!(" for {mean:.2} s simulated"),
-            s.in_progress.iter().filter(|p| p.checkpoint.is_some_and(|c| c.0 >= mean)).count(),
-        ),
-        None => (String::new(), 0),
-    };
-    let past = match past {
+    let simulated = s.mean_simulated_time_done.map(|t| format!(" for {t:.2} s simulated")).unwrap_or_default();
+    let past = match simulated_shares(s).filter(|&share| share >= 1.0).count() {
         0 => String::new(),
         k => format!("; {k} job(s) already past that, whose end is not estimated"),
     };
