@@ -95,11 +95,21 @@ pub enum CalibrationFile {
     Eq11,
 }
 
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ContactPointFile {
+    /// The centroid of the overlap; a face on a wall spreads over its corners (default).
+    CentreOfPressure,
+    /// EPA's witness midpoint, and the deepest vertex against a wall: the paper's software.
+    Witness,
+}
+
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SolverFile {
     pub time_step: Option<f64>,
     pub calibration: Option<CalibrationFile>,
+    pub contact_point: Option<ContactPointFile>,
     pub max_time: Option<Auto>,
 }
 

@@ -6,16 +6,16 @@ use std::path::Path;
 
 use analysis::Experiment;
 use nalgebra::Vector3;
-use solver::dem::{Calibration, Domain, Material};
+use solver::dem::{Calibration, ContactPoint, Domain, Material};
 use solver::fluid::flow::Flow;
 use solver::grain::simplify::DEFAULT_MAX_FACES;
 use solver::grain::{FormDistribution, SieveCurve, Table3Case};
 use solver::packing::{DomainKind, FluidSpec, FormSpec, PackingSpec, Process, ShapeKind, SpecError, in_range};
 
 use crate::job_file::{
-    CalibrationFile, DomainFile, DomainKindFile, EvaluationFile, ExperimentFile, FlowFile, FlowKindFile, FluidFile,
-    FormFile, GrainsFile, JobFile, MaterialFile, ProcessFile, ProcessFluidFile, ShapeFile, SizeFile, SolverFile,
-    Source, read_job_file,
+    CalibrationFile, ContactPointFile, DomainFile, DomainKindFile, EvaluationFile, ExperimentFile, FlowFile,
+    FlowKindFile, FluidFile, FormFile, GrainsFile, JobFile, MaterialFile, ProcessFile, ProcessFluidFile, ShapeFile,
+    SizeFile, SolverFile, Source, read_job_file,
 };
 use crate::meshes;
 
@@ -168,6 +168,13 @@ fn solver(s: SolverFile, spec: &mut PackingSpec) {
         s.calibration.map(|c| match c {
             CalibrationFile::Discrete => Calibration::Discrete,
             CalibrationFile::Eq11 => Calibration::Continuous,
+        }),
+    );
+    set(
+        &mut spec.contact_point,
+        s.contact_point.map(|c| match c {
+            ContactPointFile::CentreOfPressure => ContactPoint::CentreOfPressure,
+            ContactPointFile::Witness => ContactPoint::Witness,
         }),
     );
     spec.process.max_time = s.max_time.and_then(|t| t.given());

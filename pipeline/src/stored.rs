@@ -14,6 +14,10 @@
 //!   2 have not: a job without them is still written in format 2, the same bytes and id as
 //!   before, and a version that knows only formats 1 and 2 refuses a job with them instead of
 //!   running it without.
+//! - Format 4 is format 2 or 3 whose identity puts the contact point of polyhedra at EPA's
+//!   witness (`packing.contact_point`, the rule of the paper's software), which formats 1 to 3
+//!   have not: a job with the centre of pressure is written as before, and a version that knows
+//!   only formats 1 to 3 refuses a job with the witness instead of running it with the centre.
 //!
 //! A stored format is frozen: a release that adds a field writes a new format with its own types
 //! beside these, keeps reading every older one (giving the new field the value that reproduces
@@ -22,7 +26,7 @@
 use anyhow::{Context, bail};
 use nalgebra::Vector3;
 use sha2::{Digest, Sha256};
-use solver::dem::{Calibration, Domain, Material, Shaking};
+use solver::dem::{Calibration, ContactPoint, Domain, Material, Shaking};
 use solver::fluid::flow::Flow;
 use solver::grain::{FormDistribution, MeshLibrary, SieveCurve, Table3Case};
 use solver::packing::{FluidSpec, FormSpec, GrainSpec, PackingSpec, Process, ShapeKind};
@@ -31,11 +35,20 @@ use crate::meshes;
 use crate::spec::JobSpec;
 
 /// The newest format this version reads and writes.
-pub const FORMAT: u32 = 3;
+pub const FORMAT: u32 = 4;
 
 /// The format a job is written in: the oldest of this version's that holds it.
 pub fn format(job: &JobSpec) -> u32 {
-    if job.packing.fluid.is_some() { 3 } else { 2 }
+    needed(job.packing.contact_point == ContactPoint::Witness, job.packing.fluid.is_some())
+}
+
+/// The oldest format with a witness contact point and fluid forces if these are present.
+fn needed(witness: bool, fluid: bool) -> u32 {
+    match (witness, fluid) {
+        (true, _) => 4,
+        (false, true) => 3,
+        (false, false) => 2,
+    }
 }
 /// A mesh folder's name in a format 2 identity.
 const FOLDER: &str = "folder";
@@ -69,6 +82,16 @@ mod v1 {
         /// Format 3 only; absent, it leaves the bytes of formats 1 and 2 as they were.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub(super) fluid: Option<Fluid>,
+        /// Format 4 only; absent (the centre of pressure), it leaves the bytes of formats 1 to 3
+        /// as they were.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub(super) contact_point: Option<ContactPoint>,
+    }
+
+    /// A contact point other than the centre of pressure, the only one formats 1 to 3 know.
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    pub(super) enum ContactPoint {
+        Witness,
     }
 
     #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -186,7 +209,7 @@ mod v1 {
     }
 }
 
-/// Formats 2 and 3: format 1's job with the place of its mesh folder taken out of it.
+/// Formats 2 to 4: format 1's job with the place of its mesh folder taken out of it.
 mod v2 {
     use serde::{Deserialize, Serialize};
 
@@ -224,7 +247,7 @@ pub fn job_id(job: &JobSpec) -> String {
 pub fn decode(format: u32, json: &serde_json::Value) -> anyhow::Result<JobSpec> {
     let job = match format {
         1 => serde_json::from_value(json.clone()).context("the stored job is not format 1")?,
-        2 | 3 => {
+        2..=4 => {
             let v2::Job { mut job, mesh_folder } = serde_json::from_value(json.clone())
                 .with_context(|| format!("the stored job is not format {format}"))?;
             let named = job.packing.grains.meshes.as_mut().map(|m| &mut m.source);
@@ -244,8 +267,12 @@ pub fn decode(format: u32, json: &serde_json::Value) -> anyhow::Result<JobSpec> 
              cannot read: a newer sedpack stored it"
         ),
     };
-    if job.packing.fluid.is_some() != (format == 3) {
-        bail!("the stored job is not format {format}: format 3 is the one with fluid forces");
+    let wanted = needed(job.packing.contact_point.is_some(), job.packing.fluid.is_some());
+    if wanted != format && !(format == 1 && wanted == 2) {
+        bail!(
+            "the stored job is not format {format}: format 3 is the one with fluid forces, format 4 the one \
+             with EPA's witness as the contact point of polyhedra"
+        );
     }
     from_v1(job)
 }
@@ -313,6 +340,10 @@ fn from_v1(job: v1::Job) -> anyhow::Result<JobSpec> {
         },
         time_step,
         calibration,
+        contact_point: match p.contact_point {
+            None => ContactPoint::CentreOfPressure,
+            Some(v1::ContactPoint::Witness) => ContactPoint::Witness,
+        },
         process: Process {
             spacing: Some(p.process.spacing),
             velocity: p.process.velocity,
@@ -428,6 +459,10 @@ fn identity(job: &JobSpec) -> v1::Job {
                 cell: derived.fluid_cell,
                 coupling: Some(derived.fluid_coupling),
             }),
+            contact_point: match spec.contact_point {
+                ContactPoint::CentreOfPressure => None,
+                ContactPoint::Witness => Some(v1::ContactPoint::Witness),
+            },
         },
         experiment: job.experiment.map(|e| v1::Experiment { porosity: e.porosity, std: e.std }),
     }
@@ -535,10 +570,39 @@ mod tests {
     }
 
     #[test]
+    fn a_job_with_the_witness_contact_point_is_format_4_and_the_centre_of_pressure_keeps_its_id() {
+        let mut spec = PackingSpec::paper(DomainKind::Cylinder);
+        spec.contact_point = ContactPoint::Witness;
+        let original = job(spec);
+        assert_eq!(format(&original), 4);
+        let stored = encode(&original);
+        assert_eq!(stored["job"]["packing"]["contact_point"], "Witness");
+        let back = decode(4, &stored).unwrap();
+        assert_eq!(back.packing.contact_point, ContactPoint::Witness);
+        assert_eq!(canonical_json(&back), canonical_json(&original));
+        let centre = job(PackingSpec::paper(DomainKind::Cylinder));
+        assert_ne!(job_id(&original), job_id(&centre));
+        // The centre of pressure is what formats 1 to 3 mean: no key, the same bytes and id.
+        assert!(encode(&centre)["job"]["packing"].get("contact_point").is_none());
+        assert_eq!(format(&centre), 2);
+        // With fluid forces too it is still format 4; without the key, format 4 is refused.
+        let mut both = original.clone();
+        both.packing.fluid = Some(FluidSpec::STILL_WATER);
+        assert_eq!(format(&both), 4);
+        assert!(decode(4, &encode(&both)).unwrap().packing.fluid.is_some());
+        for older in [2, 3] {
+            let error = decode(older, &stored).unwrap_err().to_string();
+            assert!(error.contains("format 4 the one with EPA's witness"), "{error}");
+        }
+        let error = decode(4, &encode(&centre)).unwrap_err().to_string();
+        assert!(error.contains("not format 4"), "{error}");
+    }
+
+    #[test]
     fn stored_jobs_that_disagree_with_themselves_or_another_format_are_refused() {
         let stored = encode(&job(PackingSpec::paper(DomainKind::Periodic)));
-        let error = decode(4, &stored).unwrap_err().to_string();
-        assert!(error.contains("format 4") && error.contains("formats 1 to 3"), "{error}");
+        let error = decode(5, &stored).unwrap_err().to_string();
+        assert!(error.contains("format 5") && error.contains("formats 1 to 4"), "{error}");
         let error = format!("{:#}", decode(1, &stored).unwrap_err());
         assert!(error.contains("not format 1"), "{error}");
         let error = decode(3, &stored).unwrap_err().to_string();

@@ -94,6 +94,8 @@ fn bad_job_files_name_the_file_line_and_key() {
     fails(&["pack", &mass], &["mass.yaml:2", "grains.mass", "-2"]);
     let wrong = write(dir.path(), "wrong.yaml", "seed: many\n");
     fails(&["pack", &wrong], &["wrong.yaml:1", "seed"]);
+    let point = write(dir.path(), "point.yaml", "solver:\n  contact_point: epa\n");
+    fails(&["pack", &point], &["point.yaml:2", "contact_point", "centre-of-pressure", "witness"]);
     let step = write(dir.path(), "step.yaml", "solver: {time_step: 1.0e-4}\n");
     fails(&["pack", &step], &["step.yaml:1", "solver.time_step", "collision_time / 10"]);
     let case = write(dir.path(), "case.yaml", "grains: {size: U4}\n");

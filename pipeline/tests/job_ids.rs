@@ -109,3 +109,25 @@ fn the_table_6_and_7_campaigns_are_the_papers_setups() {
         }
     }
 }
+
+#[test]
+fn the_contact_point_study_is_table_6_u1_with_only_the_contact_point_changed() {
+    use solver::dem::ContactPoint;
+    let study = sedpack::campaign::read_campaign(repo("campaigns/validation-contact-point.yaml").as_ref()).unwrap();
+    let table6 = sedpack::campaign::read_campaign(repo("campaigns/validation-cylinder.yaml").as_ref()).unwrap();
+    assert_eq!(study.jobs.len(), 3);
+    for job in &study.jobs {
+        let witness = &job.spec.packing;
+        assert_eq!(witness.contact_point, ContactPoint::Witness);
+        assert_eq!(sedpack::stored::format(&job.spec), 4);
+        let centre = table6
+            .jobs
+            .iter()
+            .map(|j| &j.spec.packing)
+            .find(|p| p.seed == witness.seed && p.grains.size.case().map(|c| c.name) == Some("U1"))
+            .unwrap();
+        let mut same = witness.clone();
+        same.contact_point = ContactPoint::CentreOfPressure;
+        assert_eq!(&same, centre, "seed {}", witness.seed);
+    }
+}

@@ -20,6 +20,7 @@ use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use parry3d_f64::math::{Pose, Rotation as PRotation, Vector as PVector};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use solver::dem::contact::ContactPoint;
 use solver::dem::contact::coherence::Features;
 use solver::dem::contact::polyhedron::{
     Mode, PolyhedronPose, polyhedron_plane, polyhedron_polyhedron, polyhedron_polyhedron_coherent,
@@ -132,7 +133,17 @@ fn pairs(g: &Grains) -> Vec<Pair> {
         pair.xb = m * (outside - 1e-3 * 0.5 * size);
         let (pa, pb) = pair.poses(g);
         let mut features = Features::default();
-        let Some(contact) = polyhedron_polyhedron_coherent(&pa, &pb, None, 0.0, &mut features, Mode::Coherent).0 else {
+        let Some(contact) = polyhedron_polyhedron_coherent(
+            &pa,
+            &pb,
+            None,
+            0.0,
+            &mut features,
+            Mode::Coherent,
+            ContactPoint::CentreOfPressure,
+        )
+        .0
+        else {
             continue;
         };
         pair.previous_normal = contact.normal;
@@ -197,21 +208,27 @@ fn polyhedron_pairs(c: &mut Criterion) {
                 (a, b, p.previous_normal, p.features)
             })
             .collect();
-        group.bench_function("engine, kept features", |bench| {
-            bench.iter(|| {
-                for (a, b, n, f) in &kept {
-                    let mut features = *f;
-                    black_box(polyhedron_polyhedron_coherent(
-                        black_box(a),
-                        black_box(b),
-                        Some(n),
-                        0.0,
-                        &mut features,
-                        Mode::Coherent,
-                    ));
-                }
-            })
-        });
+        for (name, rule) in [
+            ("engine, kept features", ContactPoint::CentreOfPressure),
+            ("engine, kept features, witness point", ContactPoint::Witness),
+        ] {
+            group.bench_function(name, |bench| {
+                bench.iter(|| {
+                    for (a, b, n, f) in &kept {
+                        let mut features = *f;
+                        black_box(polyhedron_polyhedron_coherent(
+                            black_box(a),
+                            black_box(b),
+                            Some(n),
+                            0.0,
+                            &mut features,
+                            Mode::Coherent,
+                            rule,
+                        ));
+                    }
+                })
+            });
+        }
         let parry_pairs: Vec<(Pose, Pose, usize, usize)> = pairs
             .iter()
             .map(|p| {

@@ -22,7 +22,7 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::SolverError;
 use crate::dem::shape::{ConvexPolyhedron, Polyhedron};
-use crate::dem::{Calibration, Domain, Material, NewBody, Settings, Shape, Simulation, uniform_rotation};
+use crate::dem::{Calibration, ContactPoint, Domain, Material, NewBody, Settings, Shape, Simulation, uniform_rotation};
 use crate::grain::{RHINE_FORMS, SieveCurve, UnitMesh, bonded_grain, rhine_meshes, simplify};
 use crate::packing::ShapeKind;
 
@@ -64,7 +64,13 @@ impl BedSpec {
 
 /// The paper's material and time step (§4.2) with the given skin.
 pub fn settings(skin: f64) -> Settings {
-    Settings { material: Material::default(), time_step: 5e-6, skin, calibration: Calibration::Discrete }
+    Settings {
+        material: Material::default(),
+        time_step: 5e-6,
+        skin,
+        calibration: Calibration::Discrete,
+        contact_point: ContactPoint::CentreOfPressure,
+    }
 }
 
 /// Where a bed's preparation stands, for progress displays.

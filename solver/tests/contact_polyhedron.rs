@@ -17,14 +17,15 @@ use parry3d_f64::query::details::contact_support_map_support_map;
 use parry3d_f64::shape::SupportMap;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use solver::dem::contact::ContactGeometry;
 use solver::dem::contact::centre_of_pressure::Overlap;
 use solver::dem::contact::coherence::Features;
 use solver::dem::contact::ellipsoid::EllipsoidPose;
 use solver::dem::contact::polyhedron::{
-    Mode, PolyhedronPose, polyhedron_cylinder_wall, polyhedron_ellipsoid, polyhedron_plane, polyhedron_polyhedron,
-    polyhedron_polyhedron_coherent, polyhedron_polyhedron_with_stats, polyhedron_sphere,
+    Mode, PolyhedronPose, polyhedron_cylinder_wall, polyhedron_cylinder_wall_witness, polyhedron_ellipsoid,
+    polyhedron_plane, polyhedron_plane_witness, polyhedron_polyhedron, polyhedron_polyhedron_coherent,
+    polyhedron_polyhedron_with_stats, polyhedron_sphere,
 };
+use solver::dem::contact::{ContactGeometry, ContactPoint};
 use solver::dem::shape::ConvexPolyhedron;
 use solver::dem::uniform_rotation;
 use solver::grain::TriMesh;
@@ -461,6 +462,49 @@ fn cylinder_wall() {
     assert!(polyhedron_cylinder_wall(&inside, 0.0, 0.0, radius).is_none());
 }
 
+#[test]
+fn the_witness_point_against_a_wall_is_the_deepest_vertex_half_the_depth_back() {
+    // The rule of the paper's software: one point, at the vertex deepest in the wall, moved back
+    // along the normal by half the depth (midway between the vertex and the wall's surface).
+    let h = 0.5;
+    let cube = cuboid(2.0 * h, 2.0 * h, 2.0 * h);
+    let depth = 1e-3;
+    // Flat on the floor, turned about z: the point is one of the four bottom corners.
+    for turn in [0.0, 0.3, 1.2] {
+        let r = rotation(V3::z(), turn);
+        let center = V3::new(0.3, -0.2, h - depth);
+        let c = polyhedron_plane_witness(&PolyhedronPose::new(&cube, center, &r), &V3::zeros(), &V3::z()).unwrap();
+        assert!((c.depth - depth).abs() < 1e-14 && (c.normal + V3::z()).norm() < 1e-15, "{c:?}");
+        assert!((c.point.z + 0.5 * depth).abs() < 1e-14, "{}", c.point);
+        let corners =
+            [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)].map(|(x, y)| center + r * V3::new(x * h, y * h, 0.0));
+        let nearest = corners.iter().map(|k| (k.xy() - c.point.xy()).norm()).fold(f64::INFINITY, f64::min);
+        assert!(nearest < 1e-14, "point {} is no corner", c.point);
+        // The centre of pressure is the middle of the face.
+        let centre = polyhedron_plane(&PolyhedronPose::new(&cube, center, &r), &V3::zeros(), &V3::z()).unwrap();
+        assert!((centre.point.xy() - center.xy()).norm() < 1e-14);
+    }
+    // Tilted about y by 0.1 rad: the corners on the side that went down are deepest, at
+    // x = 0.3 + h(cos 0.1 + sin 0.1) relative to... worked out from the rotation itself.
+    let r = rotation(V3::y(), 0.1);
+    let low = (0..8).map(|k| r * cube.vertices()[k]).min_by(|p, q| p.z.total_cmp(&q.z)).unwrap();
+    let center = V3::new(0.3, -0.2, -low.z - depth);
+    let c = polyhedron_plane_witness(&PolyhedronPose::new(&cube, center, &r), &V3::zeros(), &V3::z()).unwrap();
+    assert!((c.depth - depth).abs() < 1e-14);
+    assert!((c.point.x - (center.x + low.x)).abs() < 1e-14 && (c.point.z + 0.5 * depth).abs() < 1e-14, "{}", c.point);
+    // The cylinder wall, corner first: the corner, half the depth back towards the axis.
+    let radius = 10.0;
+    let r = Rotation3::rotation_between(&V3::new(1.0, 1.0, 0.0), &V3::x()).unwrap().into_inner();
+    let half_diagonal = 2f64.sqrt() * h;
+    let pose = PolyhedronPose::new(&cube, V3::new(10.0 + radius - half_diagonal + depth, 10.0, 3.0), &r);
+    let c = polyhedron_cylinder_wall_witness(&pose, 10.0, 10.0, radius).unwrap();
+    assert!((c.depth - depth).abs() < 1e-13 && (c.normal - V3::x()).norm() < 1e-15);
+    assert!((c.point.x - (10.0 + radius + 0.5 * depth)).abs() < 1e-12 && (c.point.y - 10.0).abs() < 1e-12);
+    assert!((c.point.z - 3.0).abs() > 0.5 * h, "a corner is at z = 3 ± {h}: {}", c.point);
+    let inside = PolyhedronPose::new(&cube, V3::new(0.0, radius - half_diagonal - 0.01, 0.0), &r);
+    assert!(polyhedron_cylinder_wall_witness(&inside, 0.0, 0.0, radius).is_none());
+}
+
 // ---------------------------------------------------------------------------------------------
 // Polyhedron pairs
 
@@ -634,6 +678,65 @@ fn random_pairs_match_the_separating_axis_theorem_and_parry() {
 }
 
 #[test]
+fn the_witness_point_is_midway_between_the_deepest_points_where_they_are_unique() {
+    // Where the separating-axis minimum is one axis and A or B meets it with a single vertex
+    // (vertex into face), or both with an edge (edge across edge), the deepest points are
+    // unique: a vertex and its foot on the other body's face, or the closest points of the two
+    // edges' lines. EPA's witness midpoint must be their midpoint to rounding (bodies of size
+    // ~1): its last face lies on K's face along the normal (to EPA's gap of 1e-12), and signed
+    // barycentric coordinates give the edges' points even when that face is the half of the
+    // edge–edge parallelogram that does not hold δn (clamped ones missed by up to 0.2 here).
+    let mut rng = ChaCha8Rng::seed_from_u64(23);
+    let (mut worst, mut vertex_face, mut edge_edge) = (0.0f64, 0, 0);
+    for _ in 0..600 {
+        let pair = RandomPair::new(&mut rng);
+        let a = pair.a();
+        let b = pair.b_at(rng.random_range(0.5..1.0));
+        let (wa, wb) = (World::of(&a), World::of(&b));
+        let (depth, n, second) = sat(&wa, &wb);
+        if depth < 1e-6 || second - depth < 1e-6 {
+            continue;
+        }
+        let top = wa.max_along(&n);
+        let bottom = -wb.max_along(&-n);
+        let deepest_a: Vec<V3> = wa.vertices.iter().filter(|v| top - v.dot(&n) < 1e-9).copied().collect();
+        let deepest_b: Vec<V3> = wb.vertices.iter().filter(|v| v.dot(&n) - bottom < 1e-9).copied().collect();
+        let expected = match (deepest_a.len(), deepest_b.len()) {
+            (1, k) if k >= 3 => {
+                vertex_face += 1;
+                deepest_a[0] - n * (0.5 * depth)
+            }
+            (k, 1) if k >= 3 => {
+                vertex_face += 1;
+                deepest_b[0] + n * (0.5 * depth)
+            }
+            (2, 2) => {
+                // Closest points p + s u and q + t w of the two lines.
+                let (p, u) = (deepest_a[0], deepest_a[1] - deepest_a[0]);
+                let (q, w) = (deepest_b[0], deepest_b[1] - deepest_b[0]);
+                let r = p - q;
+                let (uu, uw, ww, ur, wr) = (u.dot(&u), u.dot(&w), w.dot(&w), u.dot(&r), w.dot(&r));
+                let det = uu * ww - uw * uw;
+                let (s, t) = ((uw * wr - ww * ur) / det, (uu * wr - uw * ur) / det);
+                edge_edge += 1;
+                (p + u * s + q + w * t) * 0.5
+            }
+            _ => continue,
+        };
+        let mut features = Features::default();
+        let (contact, _, stats) =
+            polyhedron_polyhedron_coherent(&a, &b, None, 0.0, &mut features, Mode::Full, ContactPoint::Witness);
+        let c = contact.expect("the bodies overlap");
+        assert_eq!(stats.overlap, Some(Overlap::Witness));
+        assert!((c.depth - depth).abs() < 1e-12);
+        worst = worst.max((c.point - expected).norm());
+    }
+    eprintln!("{vertex_face} vertex–face and {edge_edge} edge–edge contacts: worst witness point error {worst:e}");
+    assert!(vertex_face > 50 && edge_edge > 50, "{vertex_face}, {edge_edge}");
+    assert!(worst < 1e-12, "{worst}");
+}
+
+#[test]
 fn swapping_the_bodies_negates_the_normal_only() {
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let mut checked = 0;
@@ -753,7 +856,15 @@ fn a_pair_still_apart_along_its_last_separating_direction_costs_one_query() {
         }
         tested += 1;
         let mut features = Features::default();
-        let (contact, first, _) = polyhedron_polyhedron_coherent(&a, &b, None, 0.0, &mut features, Mode::Coherent);
+        let (contact, first, _) = polyhedron_polyhedron_coherent(
+            &a,
+            &b,
+            None,
+            0.0,
+            &mut features,
+            Mode::Coherent,
+            ContactPoint::CentreOfPressure,
+        );
         assert!(contact.is_none());
         let d = parry_distance(&a, &b);
         let g = first.gap;
@@ -762,8 +873,15 @@ fn a_pair_still_apart_along_its_last_separating_direction_costs_one_query() {
         let shift = random_unit(&mut rng) * (rng.random_range(0.0..0.3) * g);
         let turn = rotation(random_unit(&mut rng), 0.1 * g / sb.bounding_radius()) * rb;
         let moved = PolyhedronPose::new(sb, b.center() + shift, &turn);
-        let (contact, apart, stats) =
-            polyhedron_polyhedron_coherent(&a, &moved, Some(&first.direction), g, &mut features, Mode::Coherent);
+        let (contact, apart, stats) = polyhedron_polyhedron_coherent(
+            &a,
+            &moved,
+            Some(&first.direction),
+            g,
+            &mut features,
+            Mode::Coherent,
+            ContactPoint::CentreOfPressure,
+        );
         assert!(contact.is_none());
         assert_eq!(stats.support_queries, 1);
         // The same direction, normalised again.
@@ -772,8 +890,15 @@ fn a_pair_still_apart_along_its_last_separating_direction_costs_one_query() {
         assert!(apart.gap >= 0.6 * g - 1e-12 && apart.gap <= d + 1e-9, "bound {} of {g}, distance {d}", apart.gap);
 
         let closer = PolyhedronPose::new(sb, b.center() - first.direction * (0.8 * g), &rb);
-        let (contact, apart, stats) =
-            polyhedron_polyhedron_coherent(&a, &closer, Some(&first.direction), g, &mut features, Mode::Coherent);
+        let (contact, apart, stats) = polyhedron_polyhedron_coherent(
+            &a,
+            &closer,
+            Some(&first.direction),
+            g,
+            &mut features,
+            Mode::Coherent,
+            ContactPoint::CentreOfPressure,
+        );
         assert!(contact.is_none());
         assert!(stats.support_queries > 1, "{stats:?}");
         let d = parry_distance(&a, &closer);
@@ -1006,15 +1131,32 @@ fn the_engines_shortcuts_on_persisting_contacts_match_independent_references() {
         let depth = if k % 2 == 0 { 1e-3 } else { 1e-2 } * size;
         let b = PolyhedronPose::new(&sb, m * (outside - depth), &rb);
         let mut features = Features::default();
-        let Some(first) = polyhedron_polyhedron_coherent(&a, &b, None, 0.0, &mut features, Mode::Coherent).0 else {
+        let Some(first) = polyhedron_polyhedron_coherent(
+            &a,
+            &b,
+            None,
+            0.0,
+            &mut features,
+            Mode::Coherent,
+            ContactPoint::CentreOfPressure,
+        )
+        .0
+        else {
             continue;
         };
         let turn = |r: &Matrix3<f64>, rng: &mut ChaCha8Rng| rotation(random_unit(rng), 1e-4) * r;
         let (ra2, rb2) = (turn(&ra, &mut rng), turn(&rb, &mut rng));
         let a2 = PolyhedronPose::new(&sa, V3::zeros(), &ra2);
         let b2 = PolyhedronPose::new(&sb, b.center() + random_unit(&mut rng) * 1e-5 * size, &rb2);
-        let (c, _, stats) =
-            polyhedron_polyhedron_coherent(&a2, &b2, Some(&first.normal), 0.0, &mut features, Mode::Coherent);
+        let (c, _, stats) = polyhedron_polyhedron_coherent(
+            &a2,
+            &b2,
+            Some(&first.normal),
+            0.0,
+            &mut features,
+            Mode::Coherent,
+            ContactPoint::CentreOfPressure,
+        );
         let Some(c) = c else { continue };
         let (wa, wb) = (World::of(&a2), World::of(&b2));
         let (sat_depth, sat_normal, second) = sat(&wa, &wb);

@@ -113,13 +113,18 @@ fn fluid_forces_updated_every_twenty_steps_settle_and_turn_a_grain_as_every_step
     // while it accelerates. Measured: speeds at most 1.8e-4 u_t apart, orientations 0.007°.
     // The check: within 5e-4 u_t and 0.02° at every 5 ms over 0.3 s (six relaxation times).
     use nalgebra::UnitQuaternion;
-    use solver::dem::{Calibration, Domain, NewBody, Settings, Simulation};
+    use solver::dem::{Calibration, ContactPoint, Domain, NewBody, Settings, Simulation};
     use solver::fluid::Fluid;
     let form = FormParameters::new(6e-3, 5e-3, 2e-3).unwrap();
     let shape = Shape::from(&bonded_grain(&form).unwrap());
     let run = |coupling: u32| {
-        let settings =
-            Settings { material: material(), time_step: 5e-6, skin: 1e-4, calibration: Calibration::Discrete };
+        let settings = Settings {
+            material: material(),
+            time_step: 5e-6,
+            skin: 1e-4,
+            calibration: Calibration::Discrete,
+            contact_point: ContactPoint::CentreOfPressure,
+        };
         let mut sim = Simulation::new(Domain::Periodic { width: 0.1 }, settings).unwrap();
         sim.add_body(NewBody {
             shape: shape.clone(),

@@ -5,7 +5,7 @@
 use std::sync::OnceLock;
 
 use nalgebra::{UnitQuaternion, Vector3};
-use solver::dem::{Calibration, Domain, Material, NewBody, Settings, Shape, Simulation};
+use solver::dem::{Calibration, ContactPoint, Domain, Material, NewBody, Settings, Shape, Simulation};
 use solver::fluid::drag::FluidProperties;
 use solver::fluid::flow::Flow;
 use solver::fluid::settling::{Drop, Settling, drop, sphere_terminal_velocity};
@@ -106,7 +106,13 @@ fn a_sphere_starting_at_rest_approaches_its_terminal_velocity_as_stokes_drag_say
     let tau = exact / (9.81 * (1.0 - m.fluid_density / m.density));
     let time_step = tau / 400.0;
     for coupling in [1, 40] {
-        let settings = Settings { material: m, time_step, skin: 1e-6, calibration: Calibration::Discrete };
+        let settings = Settings {
+            material: m,
+            time_step,
+            skin: 1e-6,
+            calibration: Calibration::Discrete,
+            contact_point: ContactPoint::CentreOfPressure,
+        };
         let mut sim = Simulation::new(Domain::Periodic { width: 1e-3 }, settings).unwrap();
         sim.add_body(NewBody {
             shape: Shape::Sphere { radius: d / 2.0 },
@@ -136,7 +142,13 @@ fn a_sphere_at_rest_over_the_bed_of_a_sheared_flow_is_lifted_by_eq_8() {
     let m = material();
     let (d, z) = (2e-3, 1.5e-3);
     let flow = Flow::Laminar { shear_velocity: 0.01, depth: 0.05 };
-    let settings = Settings { material: m, time_step: 5e-6, skin: 1e-4, calibration: Calibration::Discrete };
+    let settings = Settings {
+        material: m,
+        time_step: 5e-6,
+        skin: 1e-4,
+        calibration: Calibration::Discrete,
+        contact_point: ContactPoint::CentreOfPressure,
+    };
     let mut sim = Simulation::new(Domain::Periodic { width: 0.04 }, settings).unwrap();
     sim.add_body(NewBody {
         shape: Shape::Sphere { radius: d / 2.0 },

@@ -5,7 +5,7 @@
 use nalgebra::{UnitQuaternion, Vector3};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use solver::dem::{Calibration, Domain, Material, NewBody, Settings, Shape, Simulation};
+use solver::dem::{Calibration, ContactPoint, Domain, Material, NewBody, Settings, Shape, Simulation};
 use solver::fluid::settling::{richardson_zaki_exponent, sphere_terminal_velocity};
 use solver::fluid::{Fluid, WATER};
 use solver::packing::FLUID_COUPLING;
@@ -40,7 +40,13 @@ fn hindered(d: f64, phi: f64, spheres: usize, time_step: f64) -> (f64, f64) {
             centres.push(c);
         }
     }
-    let settings = Settings { material: m, time_step, skin: 0.1 * d, calibration: Calibration::Discrete };
+    let settings = Settings {
+        material: m,
+        time_step,
+        skin: 0.1 * d,
+        calibration: Calibration::Discrete,
+        contact_point: ContactPoint::CentreOfPressure,
+    };
     let mut sim = Simulation::new(Domain::Periodic { width }, settings).unwrap();
     for c in centres {
         sim.add_body(NewBody {

@@ -11,7 +11,7 @@ pub mod shape;
 pub mod simulation;
 
 pub use body::{Bodies, NewBody, uniform_rotation};
-pub use contact::ContactGeometry;
+pub use contact::{ContactGeometry, ContactPoint};
 pub use contact_law::{Calibration, ContactHistory, LinearSpringDashpot};
 pub use domain::Domain;
 pub use material::Material;

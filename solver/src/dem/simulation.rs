@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 
 use super::body::{Bodies, NewBody};
 use super::contact;
-use super::contact::{Mode, PairCache};
+use super::contact::{ContactPoint, Mode, PairCache};
 use super::contact_law::{Calibration, ContactHistory, LinearSpringDashpot};
 use super::domain::Domain;
 use super::material::Material;
@@ -47,6 +47,10 @@ pub struct Settings {
     pub skin: f64,
     /// How k_n and d_n follow from e_n and T_c.
     pub calibration: Calibration,
+    /// Where the force of a contact with a polyhedron acts. Absent in the cached states of
+    /// earlier versions, which used the centre of pressure.
+    #[serde(default)]
+    pub contact_point: ContactPoint,
 }
 
 /// Horizontal shaking force m A_s sin(2πt/T_s) (2π/T_s)² x̂, Eq. 14.
@@ -88,6 +92,7 @@ struct PairStage<'a> {
     poses: &'a [Pose],
     law: &'a LinearSpringDashpot,
     dt: f64,
+    rule: ContactPoint,
 }
 
 impl PairStage<'_> {
@@ -155,7 +160,7 @@ impl PairStage<'_> {
             let a = bodies.shape[i].piece(ka, xi, &bodies.orientation[i], &self.poses[i]);
             let b = bodies.shape[j].piece(kb, xj, &bodies.orientation[j], &self.poses[j]);
             let scale = a.smallest_half_extent().min(b.smallest_half_extent());
-            (contact::between(&a, &b, cache, &now, Mode::Coherent)?, scale)
+            (contact::between(&a, &b, cache, &now, Mode::Coherent, self.rule)?, scale)
         };
         let arm_i = geometry.point - xi;
         let arm_j = geometry.point - xj;
@@ -404,6 +409,7 @@ impl Simulation {
         }
         self.pose_bodies();
         let (bodies, poses) = (&self.bodies, &self.pipeline.poses);
+        let rule = self.settings.contact_point;
         let mut audit = Audit::default();
         for (k, pair) in self.neighbours.pairs.iter().enumerate().filter(|(_, p)| !p.spheres) {
             let (i, j) = (pair.i as usize, pair.j as usize);
@@ -413,7 +419,7 @@ impl Simulation {
             let a = bodies.shape[i].piece(ka, xi, &bodies.orientation[i], &poses[i]);
             let b = bodies.shape[j].piece(kb, xj, &bodies.orientation[j], &poses[j]);
             let now = bodies.stance(i, j, xj - xi);
-            let full = contact::between(&a, &b, &mut PairCache::default(), &now, Mode::Full);
+            let full = contact::between(&a, &b, &mut PairCache::default(), &now, Mode::Full, rule);
             audit.pairs += 1;
             let cache = self.neighbours.cache[k];
             if cache.still_apart(&now) {
@@ -421,7 +427,7 @@ impl Simulation {
                 audit.wrongly_skipped += usize::from(full.is_some());
                 continue;
             }
-            let fast = contact::between(&a, &b, &mut cache.clone(), &now, Mode::Coherent);
+            let fast = contact::between(&a, &b, &mut cache.clone(), &now, Mode::Coherent, rule);
             let size = a.bounding_radius() + b.bounding_radius();
             match (full, fast) {
                 (Some(f), Some(c)) => {
@@ -468,6 +474,7 @@ impl Simulation {
             poses,
             law: &self.law,
             dt: self.settings.time_step,
+            rule: self.settings.contact_point,
         };
         stage.run(0, &list.pairs, &mut list.history, &mut list.cache, pair_forces, loads)
     }
@@ -523,7 +530,7 @@ impl Simulation {
                 }
                 for piece in 0..shape.pieces() {
                     let p = shape.piece(piece, *x, q, pose);
-                    contact::with_walls(&p, &domain, |wall, feature, g, weight| {
+                    contact::with_walls(&p, &domain, settings.contact_point, |wall, feature, g, weight| {
                         let key = WallPoint::key(wall, piece, feature);
                         let entry = match walls.iter().position(|e| e.key == key) {
                             Some(found) => &mut walls[found],

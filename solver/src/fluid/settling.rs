@@ -7,7 +7,9 @@ use nalgebra::{UnitQuaternion, Vector3};
 use super::Fluid;
 use super::drag::{DallaValle, FluidProperties};
 use crate::SolverError;
-use crate::dem::{Calibration, Domain, MIN_STEPS_PER_COLLISION, Material, NewBody, Settings, Shape, Simulation};
+use crate::dem::{
+    Calibration, ContactPoint, Domain, MIN_STEPS_PER_COLLISION, Material, NewBody, Settings, Shape, Simulation,
+};
 
 /// The dimensionless diameter and velocity of the second paper's Eqs. 9–10 (Haider &
 /// Levenspiel's d* and u*, Dietrich's D* = d*³ and W* = u*³).
@@ -153,7 +155,13 @@ pub fn drop(drop: &Drop) -> Result<Settling, SolverError> {
     let time_step = (tau / 400.0).min(material.collision_time / MIN_STEPS_PER_COLLISION);
     let reach = shape.bounding_radius();
     let (width, start) = (40.0 * reach, 20.0 * reach);
-    let settings = Settings { material, time_step, skin: 0.1 * reach, calibration: Calibration::Discrete };
+    let settings = Settings {
+        material,
+        time_step,
+        skin: 0.1 * reach,
+        calibration: Calibration::Discrete,
+        contact_point: ContactPoint::CentreOfPressure,
+    };
     let mut sim = Simulation::new(Domain::Periodic { width }, settings)?;
     sim.add_body(NewBody {
         shape: shape.clone(),

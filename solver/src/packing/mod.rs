@@ -163,6 +163,7 @@ impl Packing {
             time_step: spec.time_step,
             skin: derived.skin,
             calibration: spec.calibration,
+            contact_point: spec.contact_point,
         };
         let simulation = Simulation::new(spec.domain, settings)?;
         let grid = generation_grid(&spec, &derived);

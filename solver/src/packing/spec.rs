@@ -7,7 +7,7 @@
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::dem::{Calibration, Domain, MIN_STEPS_PER_COLLISION, Material, Shaking};
+use crate::dem::{Calibration, ContactPoint, Domain, MIN_STEPS_PER_COLLISION, Material, Shaking};
 use crate::fluid::flow::Flow;
 use crate::fluid::{Fluid, WATER};
 use crate::grain::{FormDistribution, MeshLibrary, RHINE_FORMS, SieveCurve, TABLE3};
@@ -111,6 +111,8 @@ pub struct PackingSpec {
     pub material: Material,
     pub time_step: f64,
     pub calibration: Calibration,
+    /// Where the force of a contact with a polyhedron acts.
+    pub contact_point: ContactPoint,
     pub process: Process,
     /// Slice height, cut-off porosity and trim of §4.4; a trim of None means the paper's
     /// choice: the largest sieve (periodic domain), 0 (cylinder).
@@ -186,6 +188,7 @@ impl PackingSpec {
             material: Material::default(),
             time_step: 5e-6,
             calibration: Calibration::Discrete,
+            contact_point: ContactPoint::CentreOfPressure,
             process: Process {
                 spacing: None,
                 velocity: 1.0,

@@ -3,7 +3,7 @@
 
 use nalgebra::Vector3;
 use solver::dem::shape::Polyhedron;
-use solver::dem::{Calibration, Domain, Material, Settings, Shape, Simulation};
+use solver::dem::{Calibration, ContactPoint, Domain, Material, Settings, Shape, Simulation};
 use solver::grain::{SieveCurve, TriMesh};
 use solver::packing::{DomainKind, PackingSpec, ShapeKind};
 
@@ -68,7 +68,13 @@ pub fn rhine_mesh_path(k: usize) -> std::path::PathBuf {
 /// (gravity tilted for slopes), a 1 mm skin and the discrete calibration.
 pub fn settings(restitution: f64, friction: f64, gravity: Vector3<f64>) -> Settings {
     let material = Material { restitution, friction, gravity, ..Material::default() };
-    Settings { material, time_step: 5e-6, skin: 1e-3, calibration: Calibration::Discrete }
+    Settings {
+        material,
+        time_step: 5e-6,
+        skin: 1e-3,
+        calibration: Calibration::Discrete,
+        contact_point: ContactPoint::CentreOfPressure,
+    }
 }
 
 /// A bed of 5.6–8 mm grains in a 4 cm periodic square 15 cm high, given a generation spacing

@@ -59,7 +59,7 @@ type V2 = Vector2<f64>;
 const CAP_VERTICES: usize = 64;
 const CAP_TRIANGLES: usize = 128;
 
-/// Where the centre of pressure came from.
+/// Where the contact point came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Overlap {
     /// A vertex into a face: the centroid of a pyramid.
@@ -68,7 +68,8 @@ pub enum Overlap {
     Tetrahedron,
     /// The clipped overlap volume.
     Clipped,
-    /// Too many triangles to clip: the EPA witness midpoint.
+    /// The EPA witness midpoint: the rule asked for it ([`super::ContactPoint::Witness`]), or
+    /// the overlap had too many triangles to clip.
     Witness,
 }
 

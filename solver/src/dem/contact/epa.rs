@@ -39,6 +39,30 @@ pub(super) struct Penetration {
     pub converged: bool,
 }
 
+impl Penetration {
+    /// EPA's witness midpoint (relative to A's centre): δn in signed barycentric coordinates of
+    /// the last face, applied to its deepest points of A and of B. Signed, where `a` and `b` clamp
+    /// them: EPA may end on either of two coplanar faces (an edge–edge contact's face of K is a
+    /// parallelogram, two triangles), and the coordinates on the other one continue the same
+    /// affine map, so the witnesses stay on the two edges with a − b = δn.
+    pub fn witness(&self) -> V3 {
+        let [p, q, r] = self.face;
+        let o = self.normal * self.depth;
+        let n = &self.normal;
+        let lambda = [
+            (q.w - o).cross(&(r.w - o)).dot(n),
+            (r.w - o).cross(&(p.w - o)).dot(n),
+            (p.w - o).cross(&(q.w - o)).dot(n),
+        ];
+        let sum: f64 = lambda.iter().sum();
+        if sum > 0.0 {
+            ((p.a + p.b) * lambda[0] + (q.a + q.b) * lambda[1] + (r.a + r.b) * lambda[2]) * (0.5 / sum)
+        } else {
+            (self.a + self.b) * 0.5
+        }
+    }
+}
+
 /// EPA's first iteration on a tetrahedron whose face (p0, p1, p2) was last step's answer and
 /// whose fourth corner lies far on the other side: if the tetrahedron holds the origin, that face
 /// is the nearest, and the support point along its normal lies on its plane (within `gap`),

@@ -15,6 +15,7 @@ pub mod sphere;
 pub mod support;
 
 use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
 
 pub use self::coherence::{PairCache, Stance};
 use self::ellipsoid::EllipsoidPose;
@@ -24,11 +25,25 @@ pub use self::polyhedron::Mode;
 use self::support::PolyhedronPose;
 use super::domain::Domain;
 
+/// Where the force of a contact with a polyhedron acts (spheres and ellipsoids have one point,
+/// midway between their deepest points, either way).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ContactPoint {
+    /// The centroid of the overlap, the centre of pressure of a Winkler contact
+    /// ([`centre_of_pressure`]); a face lying on a wall spreads over its corners ([`manifold`]).
+    #[default]
+    CentreOfPressure,
+    /// What the paper's software does (waLBerla's MESA-PD, §3.1): EPA's witness midpoint between
+    /// two polyhedra, and against a wall the deepest vertex moved back half the depth, one point.
+    Witness,
+}
+
 /// Geometry of one contact, the same for both bodies of the pair.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactGeometry {
     /// Contact point (world frame): midway between the two bodies' deepest points, or for two
-    /// polyhedra the centre of their overlap (the centre of pressure).
+    /// polyhedra the centre of their overlap (the centre of pressure) unless the
+    /// [`ContactPoint`] rule is EPA's witness.
     pub point: Vector3<f64>,
     /// Unit contact normal pointing from body A into body B.
     pub normal: Vector3<f64>,
@@ -87,20 +102,34 @@ impl Piece<'_> {
 /// next ([`coherence`]): on entry its last contact normal or separating direction, on exit the
 /// one found now, so that both touching and merely close pairs start warm, and the distance
 /// bound of a pair found apart, recorded with where the pair stands `now`. `mode` says
-/// whether the polyhedron shortcuts may be taken.
+/// whether the polyhedron shortcuts may be taken, `rule` where two polyhedra's force acts.
 #[inline(always)]
-pub fn between(a: &Piece, b: &Piece, cache: &mut PairCache, now: &Stance, mode: Mode) -> Option<ContactGeometry> {
+pub fn between(
+    a: &Piece,
+    b: &Piece,
+    cache: &mut PairCache,
+    now: &Stance,
+    mode: Mode,
+    rule: ContactPoint,
+) -> Option<ContactGeometry> {
     match (a, b) {
         (Piece::Sphere { center: ca, radius: ra }, Piece::Sphere { center: cb, radius: rb }) => {
             sphere::sphere_sphere(ca, *ra, cb, *rb)
         }
-        _ => curved(a, b, cache, now, mode),
+        _ => curved(a, b, cache, now, mode, rule),
     }
 }
 
 /// The non-spherical pairs, kept out of line so that the sphere path stays small.
 #[inline(never)]
-fn curved(a: &Piece, b: &Piece, cache: &mut PairCache, now: &Stance, mode: Mode) -> Option<ContactGeometry> {
+fn curved(
+    a: &Piece,
+    b: &Piece,
+    cache: &mut PairCache,
+    now: &Stance,
+    mode: Mode,
+    rule: ContactPoint,
+) -> Option<ContactGeometry> {
     let start = (cache.warm != Vector3::zeros()).then_some(cache.warm);
     let flip = |c: ContactGeometry| ContactGeometry { normal: -c.normal, ..c };
     let flip_apart = |a: Apart| Apart { direction: -a.direction, ..a };
@@ -113,6 +142,7 @@ fn curved(a: &Piece, b: &Piece, cache: &mut PairCache, now: &Stance, mode: Mode)
                 cache.gap,
                 &mut cache.features,
                 mode,
+                rule,
             );
             (contact, apart)
         }
@@ -149,13 +179,21 @@ fn curved(a: &Piece, b: &Piece, cache: &mut PairCache, now: &Stance, mode: Mode)
 }
 
 /// Every point of a piece's contacts with the floor (wall 0) and the cylinder wall (wall 1):
-/// `point(wall, key, contact, weight)`. A polyhedron's face lying on a wall spreads over its
-/// corners ([`manifold`]); every other contact is one point of weight 1 keyed
-/// [`manifold::SINGLE`].
+/// `point(wall, key, contact, weight)`. Under [`ContactPoint::CentreOfPressure`] a polyhedron's
+/// face lying on a wall spreads over its corners ([`manifold`]); every other contact is one
+/// point of weight 1 keyed [`manifold::SINGLE`].
 #[inline]
-pub fn with_walls(p: &Piece, domain: &Domain, mut point: impl FnMut(u32, u64, &ContactGeometry, f64)) {
+pub fn with_walls(
+    p: &Piece,
+    domain: &Domain,
+    rule: ContactPoint,
+    mut point: impl FnMut(u32, u64, &ContactGeometry, f64),
+) {
     if let Piece::Polyhedron(pose) = p {
-        polyhedron_walls(pose, domain, &mut point);
+        match rule {
+            ContactPoint::CentreOfPressure => polyhedron_walls(pose, domain, &mut point),
+            ContactPoint::Witness => polyhedron_walls_witness(pose, domain, &mut point),
+        }
         return;
     }
     if let Some(g) = with_floor(p) {
@@ -182,6 +220,24 @@ fn polyhedron_walls(pose: &PolyhedronPose, domain: &Domain, point: &mut impl FnM
         let c = diameter / 2.0;
         if let Some(m) = polyhedron::polyhedron_cylinder_wall_manifold(pose, c, c, c) {
             points_of(1, &m);
+        }
+    }
+}
+
+/// The paper's software's wall contacts of a polyhedron: one point each.
+#[inline(never)]
+fn polyhedron_walls_witness(
+    pose: &PolyhedronPose,
+    domain: &Domain,
+    point: &mut impl FnMut(u32, u64, &ContactGeometry, f64),
+) {
+    if let Some(g) = polyhedron::polyhedron_plane_witness(pose, &Vector3::zeros(), &Vector3::z()) {
+        point(0, manifold::SINGLE, &g, 1.0);
+    }
+    if let Domain::Cylinder { diameter } = *domain {
+        let c = diameter / 2.0;
+        if let Some(g) = polyhedron::polyhedron_cylinder_wall_witness(pose, c, c, c) {
+            point(1, manifold::SINGLE, &g, 1.0);
         }
     }
 }

@@ -35,7 +35,6 @@
 
 use nalgebra::{Matrix3, Vector2, Vector3};
 
-use super::ContactGeometry;
 use super::centre_of_pressure::{self, Overlap};
 use super::coherence::{Features, Order};
 use super::ellipsoid::{EllipsoidPose, tangent_basis, unit};
@@ -44,6 +43,7 @@ use super::gjk::{self, Distance};
 use super::manifold::{self, Manifold};
 pub use super::support::PolyhedronPose;
 use super::support::{Centre, Convex, Cso, Point};
+use super::{ContactGeometry, ContactPoint};
 
 type V3 = Vector3<f64>;
 type V2 = Vector2<f64>;
@@ -108,7 +108,8 @@ pub fn polyhedron_polyhedron_with_stats(
     warm_normal: Option<&V3>,
 ) -> (Option<ContactGeometry>, PolyhedronStats) {
     let mut features = Features::default();
-    let (contact, _, stats) = polyhedron_polyhedron_coherent(a, b, warm_normal, 0.0, &mut features, Mode::Full);
+    let (contact, _, stats) =
+        polyhedron_polyhedron_coherent(a, b, warm_normal, 0.0, &mut features, Mode::Full, ContactPoint::default());
     (contact, stats)
 }
 
@@ -124,7 +125,8 @@ pub enum Mode {
 /// features in and this one's out ([`super::coherence`]). Also returns, for a pair found apart,
 /// a lower bound on their distance (0 when touching or unknown), with the separating direction
 /// left in place of the contact normal as the next warm start. `last_gap` is the bound the last
-/// query found, with `warm_normal` its direction (0 if the pair was touching or is new).
+/// query found, with `warm_normal` its direction (0 if the pair was touching or is new). `rule`
+/// says where the force acts: the centre of pressure, or EPA's witness midpoint.
 pub fn polyhedron_polyhedron_coherent(
     a: &PolyhedronPose,
     b: &PolyhedronPose,
@@ -132,12 +134,13 @@ pub fn polyhedron_polyhedron_coherent(
     last_gap: f64,
     features: &mut Features,
     mode: Mode,
+    rule: ContactPoint,
 ) -> (Option<ContactGeometry>, Apart, PolyhedronStats) {
     let forward = canonical(a, b);
     let (order, first, second) = if forward { (Order::Forward, a, b) } else { (Order::Swapped, b, a) };
     let warm = warm_normal.map(|n| if forward { *n } else { -n });
     let cached = (mode == Mode::Coherent && features.order == order).then_some(*features);
-    let (contact, apart, stats, kept) = solve_polyhedra(first, second, warm.as_ref(), last_gap, cached, mode);
+    let (contact, apart, stats, kept) = solve_polyhedra(first, second, warm.as_ref(), last_gap, cached, mode, rule);
     *features = kept.map_or(Features::default(), |(a, b)| Features { a, b, order });
     let flip = |c: ContactGeometry| if forward { c } else { ContactGeometry { normal: -c.normal, ..c } };
     let apart = Apart { direction: if forward { apart.direction } else { -apart.direction }, ..apart };
@@ -175,6 +178,7 @@ fn solve_polyhedra(
     last_gap: f64,
     cached: Option<Features>,
     mode: Mode,
+    rule: ContactPoint,
 ) -> (Option<ContactGeometry>, Apart, PolyhedronStats, Option<Kept>) {
     let mut stats = PolyhedronStats::default();
     let d = *b.center() - *a.center();
@@ -257,7 +261,10 @@ fn solve_polyhedra(
         (p.vertex_a, p.vertex_b)
     });
     stats.support_queries = cso.queries;
-    let (point, overlap) = centre_of_pressure::contact_point(a, b, end, mode == Mode::Coherent);
+    let (point, overlap) = match rule {
+        ContactPoint::CentreOfPressure => centre_of_pressure::contact_point(a, b, end, mode == Mode::Coherent),
+        ContactPoint::Witness => (end.witness(), Overlap::Witness),
+    };
     stats.overlap = Some(overlap);
     let kept = features_of(end, apex);
     (
@@ -502,6 +509,37 @@ fn plane_depth(a: &PolyhedronPose, plane_point: &V3, plane_normal: &V3) -> Optio
 /// the wall's tangent plane there, which differs from the curved wall by the sag
 /// (grain width)²/(8 radius) across the contact.
 pub fn polyhedron_cylinder_wall(a: &PolyhedronPose, axis_x: f64, axis_y: f64, radius: f64) -> Option<ContactGeometry> {
+    cylinder_depth(a, axis_x, axis_y, radius)
+        .map(|(n, level, deepest, depth)| plane_contact(a, &n, level, deepest, depth))
+}
+
+/// [`polyhedron_plane`] with the point of the paper's software: A's deepest vertex moved back
+/// half the depth towards the plane.
+pub fn polyhedron_plane_witness(a: &PolyhedronPose, plane_point: &V3, plane_normal: &V3) -> Option<ContactGeometry> {
+    plane_depth(a, plane_point, plane_normal).map(|(n, _, deepest, depth)| witness_contact(a, &n, deepest, depth))
+}
+
+/// [`polyhedron_cylinder_wall`] with the point of the paper's software: the vertex farthest
+/// from the axis moved back half the depth towards the wall.
+pub fn polyhedron_cylinder_wall_witness(
+    a: &PolyhedronPose,
+    axis_x: f64,
+    axis_y: f64,
+    radius: f64,
+) -> Option<ContactGeometry> {
+    cylinder_depth(a, axis_x, axis_y, radius).map(|(n, _, deepest, depth)| witness_contact(a, &n, deepest, depth))
+}
+
+/// A's contact with a wall at its vertex `deepest`, `depth` beyond the wall's plane along `n`:
+/// midway between that vertex and the plane.
+fn witness_contact(a: &PolyhedronPose, n: &V3, deepest: u32, depth: f64) -> ContactGeometry {
+    ContactGeometry { point: a.center() + a.vertex(deepest) - n * (0.5 * depth), normal: *n, depth }
+}
+
+/// How A enters the cylinder wall: the normal into the wall through A's vertex farthest from the
+/// axis, the tangent plane's level along it from A's centre, that vertex and its depth; `None`
+/// while A lies wholly inside.
+fn cylinder_depth(a: &PolyhedronPose, axis_x: f64, axis_y: f64, radius: f64) -> Option<(V3, f64, u32, f64)> {
     let offset = V2::new(a.center().x - axis_x, a.center().y - axis_y);
     if offset.norm() + a.bounding_radius() <= radius {
         return None;
@@ -523,7 +561,7 @@ pub fn polyhedron_cylinder_wall(a: &PolyhedronPose, axis_x: f64, axis_y: f64, ra
     let n = V3::new(out.x, out.y, 0.0);
     // The tangent plane's level along n, measured from the centre.
     let level = radius - offset.dot(&out);
-    Some(plane_contact(a, &n, level, deepest, depth))
+    Some((n, level, deepest, depth))
 }
 
 /// GJK, then EPA: the minimum translational distance of two convex bodies, or, if they do not
@@ -566,12 +604,8 @@ pub fn polyhedron_cylinder_wall_manifold(
     axis_y: f64,
     radius: f64,
 ) -> Option<Manifold> {
-    let c = polyhedron_cylinder_wall(a, axis_x, axis_y, radius)?;
-    let offset = V2::new(a.center().x - axis_x, a.center().y - axis_y);
-    let level = radius - offset.dot(&c.normal.xy());
-    let mut deepest = a.cold_hint(&c.normal);
-    a.reach(&c.normal, &mut deepest);
-    Some(manifold_beyond(a, &c.normal, level, deepest, c.depth))
+    let (n, level, deepest, depth) = cylinder_depth(a, axis_x, axis_y, radius)?;
+    Some(manifold_beyond(a, &n, level, deepest, depth))
 }
 
 /// The manifold of A entering the half-space {n·(x − x_A) ≥ level} by `depth`. The footprint
