@@ -163,7 +163,8 @@ const SIMULATED: [Simulated; 29] = [
 /// meshes keeping their own forms (§5.1: any library, the paper's being its 63 Rhine scans);
 /// no fluid forces; and every other value of the protocol and the evaluation at the paper's
 /// (`PackingSpec::paper`), the grid spacing and trim of its rules included. Only the seed, the
-/// domain height, the time limit and the meshes may differ.
+/// domain height, the time limit, the meshes and the contact point of polyhedra (sedpack's
+/// centre of pressure or the paper's software's witness) may differ.
 pub fn simulated_porosity(spec: &PackingSpec) -> Option<PaperPorosity> {
     let case = spec.grains.size.case()?.name;
     let kind = if spec.domain.is_periodic() { DomainKind::Periodic } else { DomainKind::Cylinder };
@@ -189,6 +190,7 @@ pub fn simulated_porosity(spec: &PackingSpec) -> Option<PaperPorosity> {
     papers.process.max_time = spec.process.max_time;
     papers.height = spec.height;
     papers.seed = spec.seed;
+    papers.contact_point = spec.contact_point;
     // A stored job names the spacing and trim that the paper's rules give (the stored form is
     // concrete): compared as worked out, not as written.
     let rules = papers.derived();
@@ -242,7 +244,7 @@ mod tests {
     }
 
     #[test]
-    fn seed_height_time_limit_and_an_explicit_default_trim_keep_the_setup() {
+    fn seed_height_time_limit_an_explicit_default_trim_and_the_contact_point_keep_the_setup() {
         let mut spec = table7("U7");
         spec.seed = 7;
         spec.height = Some(0.5);
@@ -251,6 +253,9 @@ mod tests {
         // grid spacing Table 3's h_g, 22 mm: stored jobs name both.
         spec.trim = Some(0.0315);
         spec.process.spacing = Some(0.022);
+        assert_eq!(found(&spec).map(|f| f.1), Some(0.291));
+        // The paper's software's contact point is the paper's setup too.
+        spec.contact_point = solver::dem::ContactPoint::Witness;
         assert_eq!(found(&spec).map(|f| f.1), Some(0.291));
     }
 

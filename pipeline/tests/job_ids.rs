@@ -92,6 +92,7 @@ fn the_table_6_and_7_campaigns_are_the_papers_setups() {
         ("campaigns/validation-periodic.yaml", "Table 7", &[("U7", 0.291), ("B50", 0.246)][..]),
         ("campaigns/validation-pebbles.yaml", "Table 7", &[("U7", 0.291)][..]),
         ("campaigns/validation-pebbles-cylinder.yaml", "Table 6", &[("U1", 0.383)][..]),
+        ("campaigns/validation-contact-point.yaml", "Table 6", &[("U1", 0.383)][..]),
     ] {
         let campaign = sedpack::campaign::read_campaign(repo(file).as_ref()).unwrap();
         assert_eq!(campaign.jobs.len(), 3 * rows.len(), "{file}");
