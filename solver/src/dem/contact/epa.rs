@@ -47,13 +47,7 @@ impl Penetration {
     /// affine map, so the witnesses stay on the two edges with a − b = δn.
     pub fn witness(&self) -> V3 {
         let [p, q, r] = self.face;
-        let o = self.normal * self.depth;
-        let n = &self.normal;
-        let lambda = [
-            (q.w - o).cross(&(r.w - o)).dot(n),
-            (r.w - o).cross(&(p.w - o)).dot(n),
-            (p.w - o).cross(&(q.w - o)).dot(n),
-        ];
+        let lambda = barycentric(&self.face, &(self.normal * self.depth), &self.normal);
         let sum: f64 = lambda.iter().sum();
         if sum > 0.0 {
             ((p.a + p.b) * lambda[0] + (q.a + q.b) * lambda[1] + (r.a + r.b) * lambda[2]) * (0.5 / sum)
@@ -303,17 +297,18 @@ impl Polytope {
     }
 }
 
+/// Unnormalised signed barycentric coordinates of `o`, a point of the plane of the face
+/// (p, q, r) whose unit normal is `n`: twice the areas of the sub-triangles opposite each corner.
+fn barycentric(face: &[Point; 3], o: &V3, n: &V3) -> [f64; 3] {
+    let [p, q, r] = face;
+    [(q.w - o).cross(&(r.w - o)).dot(n), (r.w - o).cross(&(p.w - o)).dot(n), (p.w - o).cross(&(q.w - o)).dot(n)]
+}
+
 /// Depth, normal and deepest points from the face (p, q, r) nearest the origin: the origin's
 /// projection onto it, δ n, in barycentric coordinates of the face's points.
 fn penetration_on(face: [Point; 3], normal: V3, dist: f64, converged: bool) -> Penetration {
     let [p, q, r] = face;
-    let o = normal * dist;
-    let n = &normal;
-    let lambda = [
-        (q.w - o).cross(&(r.w - o)).dot(n).max(0.0),
-        (r.w - o).cross(&(p.w - o)).dot(n).max(0.0),
-        (p.w - o).cross(&(q.w - o)).dot(n).max(0.0),
-    ];
+    let lambda = barycentric(&face, &(normal * dist), &normal).map(|l| l.max(0.0));
     let sum: f64 = lambda.iter().sum();
     let lambda = if sum > 0.0 { lambda.map(|l| l / sum) } else { [1.0 / 3.0; 3] };
     Penetration {

@@ -190,10 +190,7 @@ pub fn with_walls(
     mut point: impl FnMut(u32, u64, &ContactGeometry, f64),
 ) {
     if let Piece::Polyhedron(pose) = p {
-        match rule {
-            ContactPoint::CentreOfPressure => polyhedron_walls(pose, domain, &mut point),
-            ContactPoint::Witness => polyhedron_walls_witness(pose, domain, &mut point),
-        }
+        polyhedron_walls(pose, domain, rule, &mut point);
         return;
     }
     if let Some(g) = with_floor(p) {
@@ -204,8 +201,15 @@ pub fn with_walls(
     }
 }
 
+/// A polyhedron's wall contacts: a manifold per wall under the centre of pressure, one point
+/// (the paper's software's) under the witness rule.
 #[inline(never)]
-fn polyhedron_walls(pose: &PolyhedronPose, domain: &Domain, point: &mut impl FnMut(u32, u64, &ContactGeometry, f64)) {
+fn polyhedron_walls(
+    pose: &PolyhedronPose,
+    domain: &Domain,
+    rule: ContactPoint,
+    point: &mut impl FnMut(u32, u64, &ContactGeometry, f64),
+) {
     // Each manifold is used where it is made: they are a few hundred bytes, and most grains
     // touch no wall.
     let mut points_of = |w: u32, m: &Manifold| {
@@ -213,31 +217,22 @@ fn polyhedron_walls(pose: &PolyhedronPose, domain: &Domain, point: &mut impl FnM
             point(w, m.features[j], &m.point(j), m.weights[j]);
         }
     };
-    if let Some(m) = polyhedron::polyhedron_plane_manifold(pose, &Vector3::zeros(), &Vector3::z()) {
+    let (origin, up) = (Vector3::zeros(), Vector3::z());
+    let floor = match rule {
+        ContactPoint::CentreOfPressure => polyhedron::polyhedron_plane_manifold(pose, &origin, &up),
+        ContactPoint::Witness => polyhedron::polyhedron_plane_witness(pose, &origin, &up).map(Manifold::single),
+    };
+    if let Some(m) = floor {
         points_of(0, &m);
     }
     if let Domain::Cylinder { diameter } = *domain {
         let c = diameter / 2.0;
-        if let Some(m) = polyhedron::polyhedron_cylinder_wall_manifold(pose, c, c, c) {
+        let wall = match rule {
+            ContactPoint::CentreOfPressure => polyhedron::polyhedron_cylinder_wall_manifold(pose, c, c, c),
+            ContactPoint::Witness => polyhedron::polyhedron_cylinder_wall_witness(pose, c, c, c).map(Manifold::single),
+        };
+        if let Some(m) = wall {
             points_of(1, &m);
-        }
-    }
-}
-
-/// The paper's software's wall contacts of a polyhedron: one point each.
-#[inline(never)]
-fn polyhedron_walls_witness(
-    pose: &PolyhedronPose,
-    domain: &Domain,
-    point: &mut impl FnMut(u32, u64, &ContactGeometry, f64),
-) {
-    if let Some(g) = polyhedron::polyhedron_plane_witness(pose, &Vector3::zeros(), &Vector3::z()) {
-        point(0, manifold::SINGLE, &g, 1.0);
-    }
-    if let Domain::Cylinder { diameter } = *domain {
-        let c = diameter / 2.0;
-        if let Some(g) = polyhedron::polyhedron_cylinder_wall_witness(pose, c, c, c) {
-            point(1, manifold::SINGLE, &g, 1.0);
         }
     }
 }
