@@ -40,6 +40,9 @@ pub struct JobRecord {
     pub fluid: Option<String>,
     /// The long axes' fabric against the flow, for packings that report one.
     pub imbrication: Option<Imbrication>,
+    /// The packing's setup in words, item → value (domain, grains, sieve curve, mass, shaking,
+    /// contact point…), for the report's campaign table.
+    pub setup: Vec<(String, String)>,
     /// What the packing took.
     pub cost: Cost,
 }

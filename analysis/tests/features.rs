@@ -19,6 +19,7 @@ fn record(id: &str, porosity: f64, grains: &[(f64, f64)]) -> JobRecord {
         paper: None,
         fluid: None,
         imbrication: None,
+        setup: Vec::new(),
         cost: Cost::default(),
     }
 }

@@ -76,6 +76,7 @@ fn mixture_campaign() -> Vec<JobRecord> {
                         paper: None,
                         fluid: None,
                         imbrication: None,
+                        setup: Vec::new(),
                         cost: Cost::default(),
                     });
                 }
@@ -256,6 +257,7 @@ fn validation_campaign() -> Vec<JobRecord> {
                 paper: None,
                 fluid: None,
                 imbrication: None,
+                setup: Vec::new(),
                 // Seeds 1–3: 4,000, 4,010, 4,020 grains, 2.9–3.1 s simulated, 1, 2 and 1.5 h.
                 cost: Cost {
                     grains: 4_000 + 10 * seed as u64,
@@ -299,6 +301,31 @@ fn a_single_form_validation_report_has_table_6() {
     assert_eq!(rows.len(), 6);
     assert!(md.contains("single-form packings"));
     check_html(out.path(), 3);
+}
+
+#[test]
+fn the_campaign_table_names_the_setup_its_packings_share() {
+    let mut records = validation_campaign();
+    for r in &mut records {
+        let case = r.parameters["grains.size"].as_str().unwrap().to_string();
+        r.setup = vec![
+            ("domain".into(), "cylinder, L = 0.104 m, H = 1 m".into()),
+            ("sieve curve".into(), format!("{case} (Table 3)")),
+            ("contact point".into(), "EPA's witness midpoint (the paper's software)".into()),
+        ];
+    }
+    let out = tempfile::tempdir().unwrap();
+    let md = std::fs::read_to_string(report("validation", &records, out.path()).markdown).unwrap();
+    let campaign = &md[..md.find("## Packings").expect(&md)];
+    assert!(campaign.contains("| domain | cylinder, L = 0.104 m, H = 1 m |"), "{campaign}");
+    assert!(campaign.contains("| contact point | EPA's witness midpoint (the paper's software) |"), "{campaign}");
+    // The sieve curve differs by the grid key, which the table gives with its values instead.
+    assert!(!campaign.contains("| sieve curve |"), "{campaign}");
+    assert!(campaign.contains("| `grains.size` | U1, U3 |"), "{campaign}");
+    // A packing whose spec could not be read has no setup: nothing is claimed common.
+    records[0].setup.clear();
+    let md = std::fs::read_to_string(report("validation", &records, out.path()).markdown).unwrap();
+    assert!(!md.contains("| domain |"), "{md}");
 }
 
 #[test]
@@ -395,6 +422,7 @@ fn shape_records(size_case: Option<&str>) -> Vec<JobRecord> {
                 paper: None,
                 fluid: None,
                 imbrication: None,
+                setup: Vec::new(),
                 cost: Cost::default(),
             });
         }
@@ -494,6 +522,7 @@ fn a_campaign_with_and_without_drag_compares_them_seed_by_seed() {
                 paper: None,
                 fluid: fluid.map(String::from),
                 imbrication: None,
+                setup: Vec::new(),
                 cost: Cost::default(),
             });
         }
@@ -549,6 +578,7 @@ fn the_imbrication_of_each_setup_is_summed_over_its_runs() {
                 paper: None,
                 fluid: Some(fluid.into()),
                 imbrication: Some(f),
+                setup: Vec::new(),
                 cost: Cost::default(),
             });
         }

@@ -9,9 +9,10 @@ use analysis::record::Cost;
 use analysis::{CampaignSummary, Experiment, JobRecord};
 use anyhow::Context;
 use serde::{Deserialize, Serialize};
+use solver::dem::{ContactPoint, Domain};
 use solver::fabric::Imbrication;
 use solver::fluid::flow::Flow;
-use solver::packing::{PackingResult, PackingSpec};
+use solver::packing::{FormSpec, PackingResult, PackingSpec, ShapeKind};
 use solver::porosity::ProfilePoint;
 use store::{CampaignStatus, ExportRow, GrainStatistic, JobResult, NewJob};
 
@@ -93,6 +94,73 @@ impl FluidColumn {
     }
 }
 
+/// A number in a sentence: six decimals at most, none when whole (16 mm, not 16.000000000000004).
+fn number(x: f64) -> String {
+    format!("{}", (x * 1e6).round() / 1e6)
+}
+
+/// The packing's setup in words, item → value, as the report's campaign table shows it.
+fn setup(spec: &PackingSpec) -> Vec<(String, String)> {
+    let derived = spec.derived();
+    let domain = match spec.domain {
+        Domain::Periodic { width } => format!("periodic, L = {} m", number(width)),
+        Domain::Cylinder { diameter } => format!("cylinder, L = {} m", number(diameter)),
+    };
+    let grains = match (spec.grains.shape, &spec.grains.meshes) {
+        (ShapeKind::Mesh, Some(library)) => format!("polyhedra from {}, ≤ {} faces", library.source, library.faces),
+        (ShapeKind::Mesh, None) => "polyhedra".to_string(),
+        (ShapeKind::Sphere, _) => "spheres".to_string(),
+        (ShapeKind::Ellipsoid, _) => "ellipsoids".to_string(),
+        (ShapeKind::BondedSpheres, _) => "bonded spheres (Sun & Xiao)".to_string(),
+    };
+    let form = match spec.grains.form {
+        FormSpec::Single { fl, el } => format!("FL = {}, EL = {}", number(fl), number(el)),
+        FormSpec::Distribution(d) => format!(
+            "μ_FL = {}, σ_FL = {}, μ_EL = {}, σ_EL = {}",
+            number(d.mu_fl),
+            number(d.sigma_fl),
+            number(d.mu_el),
+            number(d.sigma_el)
+        ),
+        FormSpec::Own => "each mesh its own".to_string(),
+    };
+    let size = &spec.grains.size;
+    let curve = size.case().map_or_else(
+        || {
+            let (lo, hi, classes) = (size.smallest_in_use(), size.largest_in_use(), size.classes());
+            format!(
+                "{}–{} mm, {classes} class{}",
+                number(1e3 * lo),
+                number(1e3 * hi),
+                if classes == 1 { "" } else { "es" }
+            )
+        },
+        |c| format!("{} (Table 3)", c.name),
+    );
+    let mut items = vec![
+        ("domain", format!("{domain}, H = {} m", number(derived.height))),
+        ("grains", grains),
+        ("form", form),
+        ("sieve curve", curve),
+        ("mass", format!("{} kg", number(spec.grains.mass))),
+        ("generation spacing h_g", format!("{} mm", number(1e3 * derived.spacing))),
+        ("shaking after the last grain t_s", format!("{} s", number(spec.process.shaking_duration))),
+    ];
+    if spec.grains.shape == ShapeKind::Mesh {
+        let rule = match spec.contact_point {
+            ContactPoint::CentreOfPressure => "centre of pressure of the overlap",
+            ContactPoint::Witness => "EPA's witness midpoint (the paper's software)",
+        };
+        items.push(("contact point", rule.to_string()));
+    }
+    items.push((
+        "fluid forces",
+        FluidColumn::of(spec).map_or_else(|| "none (buoyancy only)".to_string(), |f| f.describe()),
+    ));
+    items.push(("porosity trim T", format!("{} m", number(derived.trim))));
+    items.into_iter().map(|(item, value)| (item.to_string(), value)).collect()
+}
+
 /// A finished packing's result row and grain statistics.
 pub fn result_rows(result: &PackingResult) -> (JobResult, Vec<GrainStatistic>) {
     let p = &result.porosity;
@@ -149,6 +217,7 @@ pub fn job_record(row: &ExportRow, spec: Option<&PackingSpec>) -> anyhow::Result
         paper: spec.and_then(simulated_porosity),
         fluid: fluid.map(|f| f.describe()),
         imbrication,
+        setup: spec.map(setup).unwrap_or_default(),
         cost: Cost { grains: result.particles, simulated_time: result.simulated_time, wall_time: result.wall_time },
     }))
 }
@@ -172,9 +241,57 @@ pub fn campaign_summary(status: &CampaignStatus, rows: &[ExportRow]) -> Campaign
 #[cfg(test)]
 mod tests {
     use serde_json::json;
+    use solver::grain::library::MeshLibrary;
+    use solver::grain::size::SieveCurve;
+    use solver::packing::DomainKind;
     use store::JobState;
 
     use super::*;
+
+    fn item<'a>(items: &'a [(String, String)], name: &str) -> Option<&'a str> {
+        items.iter().find(|(k, _)| k == name).map(|(_, v)| v.as_str())
+    }
+
+    #[test]
+    fn the_setup_in_words_names_the_domain_grains_and_contact_point() {
+        // Table 6's cylinder: 3 kg at n = 0.4 fill π 0.052² m² to 3/(2650 · 0.0084949 · 0.6) =
+        // 0.2221 m; H = ⌈(0.2221 + 2 · 0.016)/0.6⌉ = 0.43 m (to the centimetre); trim 0.
+        let mut cylinder = PackingSpec::paper(DomainKind::Cylinder);
+        cylinder.grains.shape = ShapeKind::Mesh;
+        cylinder.grains.form = FormSpec::Own;
+        cylinder.grains.meshes =
+            Some(MeshLibrary { source: "builtin:rhine".into(), faces: 300, digest: String::new(), meshes: vec![] });
+        cylinder.contact_point = ContactPoint::Witness;
+        let items = setup(&cylinder);
+        assert_eq!(item(&items, "domain"), Some("cylinder, L = 0.104 m, H = 0.43 m"));
+        assert_eq!(item(&items, "grains"), Some("polyhedra from builtin:rhine, ≤ 300 faces"));
+        assert_eq!(item(&items, "form"), Some("each mesh its own"));
+        assert_eq!(item(&items, "sieve curve"), Some("U1 (Table 3)"));
+        assert_eq!(item(&items, "mass"), Some("3 kg"));
+        assert_eq!(item(&items, "generation spacing h_g"), Some("16 mm"));
+        assert_eq!(item(&items, "shaking after the last grain t_s"), Some("1 s"));
+        assert_eq!(item(&items, "contact point"), Some("EPA's witness midpoint (the paper's software)"));
+        assert_eq!(item(&items, "fluid forces"), Some("none (buoyancy only)"));
+        assert_eq!(item(&items, "porosity trim T"), Some("0 m"));
+        cylinder.contact_point = ContactPoint::CentreOfPressure;
+        assert_eq!(item(&setup(&cylinder), "contact point"), Some("centre of pressure of the overlap"));
+
+        // §6: 16 kg in 0.2 m × 0.2 m reach 16/(2650 · 0.04 · 0.6) = 0.2516 m; a 4–8 mm curve
+        // without a case spaces the grid by its largest grain, H = ⌈(0.2516 + 0.016)/0.6⌉ =
+        // 0.45 m, and trims its largest sieve. Ellipsoids have no contact point to choose.
+        let mut periodic = PackingSpec::paper(DomainKind::Periodic);
+        periodic.grains.size = SieveCurve::new(vec![0.004, 0.008], vec![1.0]).unwrap();
+        periodic.fluid = Some(solver::packing::FluidSpec::STILL_WATER);
+        let items = setup(&periodic);
+        assert_eq!(item(&items, "domain"), Some("periodic, L = 0.2 m, H = 0.45 m"));
+        assert_eq!(item(&items, "grains"), Some("ellipsoids"));
+        assert_eq!(item(&items, "form"), Some("μ_FL = 0.647, σ_FL = 0.175, μ_EL = 0.682, σ_EL = 0.139"));
+        assert_eq!(item(&items, "sieve curve"), Some("4–8 mm, 1 class"));
+        assert_eq!(item(&items, "generation spacing h_g"), Some("8 mm"));
+        assert_eq!(item(&items, "contact point"), None);
+        assert_eq!(item(&items, "fluid forces"), Some("drag and lift, still water"));
+        assert_eq!(item(&items, "porosity trim T"), Some("0.008 m"));
+    }
 
     fn row(profile: serde_json::Value) -> ExportRow {
         ExportRow {

@@ -189,6 +189,13 @@ fn varied_parameters(records: &[JobRecord]) -> Vec<(String, Vec<String>)> {
     values.into_iter().filter(|(_, v)| v.len() > 1).map(|(k, v)| (k.clone(), v)).collect()
 }
 
+/// The items of the setup that every packing shares, in the first packing's order (the others
+/// differ by a grid key, which the campaign table lists with its values).
+fn common_setup(records: &[JobRecord]) -> Vec<&(String, String)> {
+    let Some((first, rest)) = records.split_first() else { return Vec::new() };
+    first.setup.iter().filter(|item| rest.iter().all(|r| r.setup.contains(item))).collect()
+}
+
 /// The shortest prefixes (at least 8 characters) that still tell the jobs apart.
 fn short_ids(records: &[JobRecord]) -> Vec<String> {
     let longest = records.iter().map(|r| r.job_id.chars().count()).max().unwrap_or(0);
@@ -222,10 +229,18 @@ fn campaign_section(
     if let Some(d) = dataset {
         rows.push(vec!["features".into(), d.kind().describe().into()]);
     }
-    for (key, values) in varied_parameters(records) {
-        rows.push(vec![format!("`{key}`"), values.join(", ")]);
-    }
     blocks.push(Block::Table { header: vec!["".into(), "value".into()], rows });
+    let mut setup: Vec<Vec<String>> =
+        common_setup(records).into_iter().map(|(item, value)| vec![item.clone(), value.clone()]).collect();
+    setup.extend(
+        varied_parameters(records).into_iter().map(|(key, values)| vec![format!("`{key}`"), values.join(", ")]),
+    );
+    if !setup.is_empty() {
+        blocks.push(Block::Paragraph(
+            "The setup every packing shares, then the keys the campaign's grid varies with their values.".into(),
+        ));
+        blocks.push(Block::Table { header: vec!["setup".into(), "value".into()], rows: setup });
+    }
     if summary.dropped_grains > 0 {
         blocks.push(Block::Paragraph(format!(
             "**Warning:** {} of the finished jobs were packed by sedpack 0.1.0, which threw away every grain that \
@@ -1193,6 +1208,7 @@ mod tests {
             paper: None,
             fluid: None,
             imbrication: None,
+            setup: Vec::new(),
             cost: Cost::default(),
         };
         let records = [record("0123456789abcdef"), record("0123456789abXdef"), record("short")];
