@@ -92,7 +92,7 @@ fn the_table_6_and_7_campaigns_are_the_papers_setups() {
         ("campaigns/validation-periodic.yaml", "Table 7", &[("U7", 0.291), ("B50", 0.246)][..]),
         ("campaigns/validation-pebbles.yaml", "Table 7", &[("U7", 0.291)][..]),
         ("campaigns/validation-pebbles-cylinder.yaml", "Table 6", &[("U1", 0.383)][..]),
-        ("campaigns/validation-contact-point.yaml", "Table 6", &[("U1", 0.383)][..]),
+        ("campaigns/validation-contact-point.yaml", "Table 6", &[("U1", 0.383), ("U7", 0.314)][..]),
     ] {
         let campaign = sedpack::campaign::read_campaign(repo(file).as_ref()).unwrap();
         assert_eq!(campaign.jobs.len(), 3 * rows.len(), "{file}");
@@ -112,12 +112,13 @@ fn the_table_6_and_7_campaigns_are_the_papers_setups() {
 }
 
 #[test]
-fn the_contact_point_study_is_table_6_u1_with_only_the_contact_point_changed() {
+fn the_contact_point_study_is_table_6_u1_and_u7_with_only_the_contact_point_changed() {
     use solver::dem::ContactPoint;
     let study = sedpack::campaign::read_campaign(repo("campaigns/validation-contact-point.yaml").as_ref()).unwrap();
     let table6 = sedpack::campaign::read_campaign(repo("campaigns/validation-cylinder.yaml").as_ref()).unwrap();
-    assert_eq!(study.jobs.len(), 3);
+    assert_eq!(study.jobs.len(), 6);
     for job in &study.jobs {
+        let case = job.spec.packing.grains.size.case().map(|c| c.name);
         let witness = &job.spec.packing;
         assert_eq!(witness.contact_point, ContactPoint::Witness);
         assert_eq!(sedpack::stored::format(&job.spec), 4);
@@ -125,10 +126,10 @@ fn the_contact_point_study_is_table_6_u1_with_only_the_contact_point_changed() {
             .jobs
             .iter()
             .map(|j| &j.spec.packing)
-            .find(|p| p.seed == witness.seed && p.grains.size.case().map(|c| c.name) == Some("U1"))
+            .find(|p| p.seed == witness.seed && p.grains.size.case().map(|c| c.name) == case)
             .unwrap();
         let mut same = witness.clone();
         same.contact_point = ContactPoint::CentreOfPressure;
-        assert_eq!(&same, centre, "seed {}", witness.seed);
+        assert_eq!(&same, centre, "{case:?}, seed {}", witness.seed);
     }
 }
