@@ -133,3 +133,30 @@ fn the_contact_point_study_is_table_6_u1_and_u7_with_only_the_contact_point_chan
         assert_eq!(&same, centre, "{case:?}, seed {}", witness.seed);
     }
 }
+
+#[test]
+fn table_11_draws_the_rhine_forms_and_the_scans_study_is_the_packing_it_ran_before() {
+    use solver::grain::form_distribution::RHINE_FORMS;
+    use solver::packing::FormSpec;
+    let table11 = sedpack::campaign::read_campaign(repo("campaigns/validation-rhine-forms.yaml").as_ref()).unwrap();
+    let scans = sedpack::campaign::read_campaign(repo("campaigns/validation-scans-periodic.yaml").as_ref()).unwrap();
+    assert_eq!((table11.jobs.len(), scans.jobs.len()), (3, 3));
+    for (drawn, own) in table11.jobs.iter().zip(&scans.jobs) {
+        assert_eq!(drawn.spec.packing.grains.form, FormSpec::Distribution(RHINE_FORMS));
+        assert_eq!(own.spec.packing.grains.form, FormSpec::Own);
+        let mut same = drawn.spec.packing.clone();
+        same.grains.form = FormSpec::Own;
+        assert_eq!(same, own.spec.packing, "the two differ by the form alone");
+    }
+    // The job that validation-rhine-forms.yaml stored for seed 1 before it had its `form:` key
+    // (sedpack 3268e0c, 2026-12-03, id b59357dd4a9c6c64), as the database holds it: the scans
+    // study's seed 1 but for the campaign's name, which is part of a job.
+    let before: Value = serde_json::from_str(
+        &std::fs::read_to_string(fixture("job-ids/validation-rhine-forms-seed-1-3268e0c.json")).unwrap(),
+    )
+    .unwrap();
+    let mut stored = sedpack::stored::encode(&scans.jobs[0].spec);
+    assert_eq!(stored["job"]["name"], "validation-scans-periodic");
+    stored["job"]["name"] = "validation-rhine-forms".into();
+    assert_eq!(stored, before);
+}
