@@ -112,6 +112,31 @@ fn the_table_6_and_7_campaigns_are_the_papers_setups() {
 }
 
 #[test]
+fn the_shaking_study_is_table_5s_u7_and_table_6s_u7_but_for_t_s() {
+    let study = sedpack::campaign::read_campaign(repo("campaigns/validation-shaking.yaml").as_ref()).unwrap();
+    let witness = sedpack::campaign::read_campaign(repo("campaigns/validation-contact-point.yaml").as_ref()).unwrap();
+    assert_eq!(study.jobs.len(), 9);
+    for job in &study.jobs {
+        let p = &job.spec.packing;
+        let want =
+            [(0.0, 0.323), (2.0, 0.309), (3.0, 0.309)].iter().find(|r| r.0 == p.process.shaking_duration).unwrap().1;
+        let paper = analysis::paper::simulated_porosity(p).unwrap();
+        assert_eq!((paper.table.as_str(), paper.porosity), ("Table 5", want));
+        let mut one_second = p.clone();
+        one_second.process.shaking_duration = 1.0;
+        one_second.process.max_time = None;
+        let table6 = witness
+            .jobs
+            .iter()
+            .map(|j| &j.spec.packing)
+            .find(|q| q.seed == p.seed && q.grains.size.case().map(|c| c.name) == Some("U7"));
+        let mut table6 = table6.unwrap().clone();
+        table6.process.max_time = None;
+        assert_eq!(one_second, table6, "t_s = {} s, seed {}", p.process.shaking_duration, p.seed);
+    }
+}
+
+#[test]
 fn the_contact_point_study_is_table_6_u1_and_u7_with_only_the_contact_point_changed() {
     use solver::dem::ContactPoint;
     let study = sedpack::campaign::read_campaign(repo("campaigns/validation-contact-point.yaml").as_ref()).unwrap();
