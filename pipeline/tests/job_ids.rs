@@ -161,6 +161,7 @@ fn the_contact_point_study_is_table_6_u1_and_u7_with_only_the_contact_point_chan
 
 #[test]
 fn table_11_draws_the_rhine_forms_and_the_scans_study_is_the_packing_it_ran_before() {
+    use solver::dem::ContactPoint;
     use solver::grain::form_distribution::RHINE_FORMS;
     use solver::packing::FormSpec;
     let table11 = sedpack::campaign::read_campaign(repo("campaigns/validation-rhine-forms.yaml").as_ref()).unwrap();
@@ -169,9 +170,11 @@ fn table_11_draws_the_rhine_forms_and_the_scans_study_is_the_packing_it_ran_befo
     for (drawn, own) in table11.jobs.iter().zip(&scans.jobs) {
         assert_eq!(drawn.spec.packing.grains.form, FormSpec::Distribution(RHINE_FORMS));
         assert_eq!(own.spec.packing.grains.form, FormSpec::Own);
+        assert_eq!(drawn.spec.packing.contact_point, ContactPoint::Witness);
         let mut same = drawn.spec.packing.clone();
         same.grains.form = FormSpec::Own;
-        assert_eq!(same, own.spec.packing, "the two differ by the form alone");
+        same.contact_point = ContactPoint::CentreOfPressure;
+        assert_eq!(same, own.spec.packing, "the two differ by the form and the contact point alone");
     }
     // The job that validation-rhine-forms.yaml stored for seed 1 before it had its `form:` key
     // (sedpack 3268e0c, 2026-12-03, id b59357dd4a9c6c64), as the database holds it: the scans
