@@ -41,7 +41,7 @@ pub struct JobRecord {
     /// The long axes' fabric against the flow, for packings that report one.
     pub imbrication: Option<Imbrication>,
     /// The packing's setup in words, item → value (domain, grains, sieve curve, mass, shaking,
-    /// contact point…), for the report's campaign table.
+    /// contact point…), for the report's setup table.
     pub setup: Vec<(String, String)>,
     /// What the packing took.
     pub cost: Cost,

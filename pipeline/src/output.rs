@@ -49,7 +49,8 @@ impl Table {
 /// A number with 6 significant digits, as a person reads it.
 pub fn number(x: f64) -> String {
     if x == 0.0 || (1e-3..1e6).contains(&x.abs()) {
-        let digits = (5 - x.abs().log10().floor() as i32).max(0) as usize;
+        // Zero apart: its log10 is −∞, which `as i32` makes i32::MIN, and 5 minus that overflows.
+        let digits = if x == 0.0 { 0 } else { (5 - x.abs().log10().floor() as i32).max(0) as usize };
         format!("{x:.digits$}")
     } else {
         format!("{x:.5e}")

@@ -17,7 +17,7 @@ use solver::porosity::ProfilePoint;
 use store::{CampaignStatus, ExportRow, GrainStatistic, JobResult, NewJob};
 
 use crate::campaign::PlannedJob;
-use crate::stored;
+use crate::{output, stored};
 
 /// The versions of sedpack whose generation threw away the grains that found no room on the grid.
 const DROPPED_GRAINS: [&str; 1] = ["0.1.0"];
@@ -94,9 +94,10 @@ impl FluidColumn {
     }
 }
 
-/// A number in a sentence: six decimals at most, none when whole (16 mm, not 16.000000000000004).
+/// A number in a sentence: [`output::number`] without its trailing zeros (16 mm, 0.104 m).
 fn number(x: f64) -> String {
-    format!("{}", (x * 1e6).round() / 1e6)
+    let s = output::number(x);
+    if s.contains('.') && !s.contains('e') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s }
 }
 
 /// The packing's setup in words, item → value, as the report's campaign table shows it.

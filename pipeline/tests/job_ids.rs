@@ -124,15 +124,12 @@ fn the_shaking_study_is_table_5s_u7_and_table_6s_u7_but_for_t_s() {
         assert_eq!((paper.table.as_str(), paper.porosity), ("Table 5", want));
         let mut one_second = p.clone();
         one_second.process.shaking_duration = 1.0;
-        one_second.process.max_time = None;
         let table6 = witness
             .jobs
             .iter()
             .map(|j| &j.spec.packing)
             .find(|q| q.seed == p.seed && q.grains.size.case().map(|c| c.name) == Some("U7"));
-        let mut table6 = table6.unwrap().clone();
-        table6.process.max_time = None;
-        assert_eq!(one_second, table6, "t_s = {} s, seed {}", p.process.shaking_duration, p.seed);
+        assert_eq!(&one_second, table6.unwrap(), "t_s = {} s, seed {}", p.process.shaking_duration, p.seed);
     }
 }
 
