@@ -1,14 +1,17 @@
 //! The porosity models published in the paper: single-form models (Eqs. 17–19, features
 //! L/S = EQ⁻¹ and L/I = EL⁻¹) and form-mixture models (Eqs. 23–24, features built from the
-//! number-based mean and standard deviation of EQ and EL), and the porosities it simulated for
-//! the setups of its calibration and validation (Tables 5–8).
+//! number-based mean and standard deviation of EQ and EL), what they give a packing in their
+//! setting, and the porosities the paper simulated for the setups of its calibration and
+//! validation (Tables 5–8).
 
 use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 use solver::packing::{DomainKind, FormSpec, GrainSpec, PackingSpec, ShapeKind};
 
+use crate::dataset::is_single_form_statistics;
 use crate::model::{CrossValidation, LinearModel};
+use crate::prediction::{input_from_grain_statistics, predict};
 
 /// Whether a paper model takes one form (FL, EL) or a form distribution (μ, σ of FL and EL).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -176,14 +179,26 @@ pub fn simulated_porosity(spec: &PackingSpec) -> Option<PaperPorosity> {
             && same(s.mass, spec.grains.mass)
             && same(s.shaking, spec.process.shaking_duration)
     })?;
+    follows_papers_protocol(spec, FormSpec::Own).then(|| PaperPorosity {
+        table: row.table.to_string(),
+        porosity: row.porosity,
+        std: row.std,
+    })
+}
+
+/// Whether `spec` is the paper's protocol (`PackingSpec::paper` of its domain's kind) for meshes
+/// of `form`, of its own domain, sieve curve, mass and shaking duration, with no fluid forces;
+/// the seed, the domain height, the time limit, the meshes and the contact point of polyhedra
+/// may differ, and the grid spacing and trim are compared as the paper's rules work them out.
+fn follows_papers_protocol(spec: &PackingSpec, form: FormSpec) -> bool {
+    let kind = if spec.domain.is_periodic() { DomainKind::Periodic } else { DomainKind::Cylinder };
     let mut papers = PackingSpec::paper(kind);
-    // The row's kind is the spec's, and its width the spec's too.
     papers.domain = spec.domain;
     papers.grains = GrainSpec {
         shape: ShapeKind::Mesh,
         size: spec.grains.size.clone(),
         mass: spec.grains.mass,
-        form: FormSpec::Own,
+        form,
         meshes: spec.grains.meshes.clone(),
     };
     papers.process.shaking_duration = spec.process.shaking_duration;
@@ -196,11 +211,71 @@ pub fn simulated_porosity(spec: &PackingSpec) -> Option<PaperPorosity> {
     let rules = papers.derived();
     (papers.process.spacing, papers.trim) = (spec.process.spacing, spec.trim);
     let derived = spec.derived();
-    (papers == *spec && (derived.spacing, derived.trim) == (rules.spacing, rules.trim)).then(|| PaperPorosity {
-        table: row.table.to_string(),
-        porosity: row.porosity,
-        std: row.std,
-    })
+    papers == *spec && (derived.spacing, derived.trim) == (rules.spacing, rules.trim)
+}
+
+/// The shaking duration t_s (s) of the packings the paper's porosity models were fitted to (§6.1).
+const MODEL_SHAKING: f64 = 6.0;
+
+/// Whether a packing is in the setting of the paper's porosity models (Eqs. 17–19, 23–24):
+/// meshes of any form in the periodic domain, shaken t_s = 6 s, by the paper's protocol
+/// otherwise (`follows_papers_protocol`). Width and mass may differ from the paper's 0.2 m and
+/// 16 kg: the models predict a property of the bed, and §6.1 found none of the domain's size
+/// from 0.1 m up (Table 7).
+pub fn in_model_setting(spec: &PackingSpec) -> bool {
+    spec.domain.is_periodic()
+        && spec.process.shaking_duration == MODEL_SHAKING
+        && follows_papers_protocol(spec, spec.grains.form)
+}
+
+/// Half the smallest nominal standard deviation of FL and EL among the paper's form-mixture
+/// packings ({0.1, 0.2}, §7.1): their measured spreads lie somewhat below nominal (the redraw of
+/// out-of-range forms), so a model is said to extrapolate only well below.
+const SMALLEST_FITTED_SPREAD: f64 = 0.05;
+
+/// What the paper's porosity model of a packing's Table 3 case gives at its grains' measured
+/// form statistics.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModelPorosity {
+    /// The model's name for `sedpack predict --model`: "paper-sf-U1", "paper-U1", …
+    pub model: String,
+    /// "Eq. 17", …
+    pub equation: String,
+    pub porosity: f64,
+    /// Why the model extrapolates for these grains, if it does.
+    pub caveat: Option<String>,
+}
+
+/// The paper's model for a packing of `spec` whose grains have the number-based (mean, std)
+/// `statistics` of the Table 1 factors: the single-form model of its case (Eqs. 17–19) for one
+/// form, the form-mixture model (Eqs. 23–24) otherwise. None outside the models' setting
+/// (`in_model_setting`) or for a case without a model (single forms: U1, U7, B50; mixtures: U1,
+/// U7).
+pub fn model_porosity(spec: &PackingSpec, statistics: &BTreeMap<String, (f64, f64)>) -> Option<ModelPorosity> {
+    if !in_model_setting(spec) {
+        return None;
+    }
+    let case = spec.grains.size.case()?.name;
+    let single = is_single_form_statistics(statistics)?;
+    let name = if single { format!("paper-sf-{case}") } else { format!("paper-{case}") };
+    let paper = paper_model(&name)?;
+    let porosity =
+        predict(&paper.model, &input_from_grain_statistics(statistics, "the packing's grains")).ok()?.porosity;
+    let narrow: Vec<String> = ["FL", "EL"]
+        .into_iter()
+        .filter_map(|f| {
+            let std = statistics.get(f)?.1;
+            (std < SMALLEST_FITTED_SPREAD).then(|| format!("σ_{f} = {std:.3}"))
+        })
+        .collect();
+    let caveat = (!single && !narrow.is_empty()).then(|| {
+        format!(
+            "{}, far below the paper's smallest spread (0.1); the form-mixture model does not hold for vanishing spread (§7.2)",
+            narrow.join(", ")
+        )
+    });
+    let equation = paper.model.campaign.unwrap_or_default().replace("Rettinger et al. (2022), ", "");
+    Some(ModelPorosity { model: name, equation, porosity, caveat })
 }
 
 #[cfg(test)]
@@ -290,5 +365,69 @@ mod tests {
             change(&mut spec);
             assert_eq!(found(&spec), None, "{what}");
         }
+    }
+
+    /// The paper's periodic setting of its models (t_s = 6 s) with meshes of the Rhine form
+    /// distribution, scaled down like Table 11's campaign (L = 0.06 m, 1.44 kg).
+    fn table11() -> PackingSpec {
+        let mut spec = PackingSpec::paper(DomainKind::Periodic);
+        spec.grains.shape = ShapeKind::Mesh;
+        (spec.domain, spec.grains.mass) = (Domain::Periodic { width: 0.06 }, 1.44);
+        spec
+    }
+
+    #[test]
+    fn the_models_setting_is_the_periodic_protocol_at_six_seconds_for_any_form_width_and_mass() {
+        assert!(in_model_setting(&table11()));
+        let mut own = table11();
+        own.grains.form = FormSpec::Own;
+        assert!(in_model_setting(&own), "the scans' own forms (Table 11's discrete variant)");
+        let mut witness = table11();
+        witness.contact_point = solver::dem::ContactPoint::Witness;
+        assert!(in_model_setting(&witness));
+        type Change = (&'static str, fn(&mut PackingSpec));
+        let changes: [Change; 4] = [
+            ("ellipsoids", |s| s.grains.shape = ShapeKind::Ellipsoid),
+            ("t_s = 1 s (Table 7)", |s| s.process.shaking_duration = 1.0),
+            ("cylinder", |s| s.domain = Domain::Cylinder { diameter: 0.104 }),
+            ("damping", |s| s.process.damping = 1e-2),
+        ];
+        for (what, change) in changes {
+            let mut spec = table11();
+            change(&mut spec);
+            assert!(!in_model_setting(&spec), "{what}");
+        }
+    }
+
+    #[test]
+    fn a_packing_gets_its_cases_model_at_its_grains_measured_forms() {
+        // One form, FL = EL = 0.5: L/S = 1/(FL·EL) = 4, L/I = 2; Eq. 17 gives
+        // 0.019·4 + 0.014·2 + 0.278 = 0.382.
+        let single = crate::form_factors::grain_statistics(&[(0.5, 0.5); 3]);
+        let p = model_porosity(&table11(), &single).expect("U1 has a single-form model");
+        assert_eq!((p.model.as_str(), p.equation.as_str(), p.caveat.as_deref()), ("paper-sf-U1", "Eq. 17", None));
+        assert!((p.porosity - 0.382).abs() < 1e-12, "{}", p.porosity);
+        // Two grains (FL, EL) = (0.4, 0.5) and (0.8, 1.0): EQ = FL·EL = 0.2 and 0.8, so
+        // μ_EQ = 0.5, σ_EQ = 0.3 (population), μ_EL = 0.75; Eq. 23 gives
+        // 0.032/0.5 − 0.003/0.3 + 0.011/0.75 + 0.287 = 0.355667.
+        let mixture = crate::form_factors::grain_statistics(&[(0.4, 0.5), (0.8, 1.0)]);
+        let p = model_porosity(&table11(), &mixture).expect("U1 has a form-mixture model");
+        assert_eq!((p.model.as_str(), p.equation.as_str(), p.caveat.as_deref()), ("paper-U1", "Eq. 23", None));
+        assert!((p.porosity - (0.064 - 0.01 + 0.011 / 0.75 + 0.287)).abs() < 1e-12, "{}", p.porosity);
+        // The two scans' forms: σ_EL of 0.006, where the paper's packings had 0.1 or 0.2.
+        let scans = crate::form_factors::grain_statistics(&[(0.446, 0.538), (0.856, 0.526)]);
+        let caveat = model_porosity(&table11(), &scans).and_then(|p| p.caveat).expect("a caveat");
+        assert!(caveat.starts_with("σ_EL = 0.006, far below"), "{caveat}");
+        // No mixture model for B50, no model at all for U3, none outside the setting.
+        let mut b50 = table11();
+        b50.grains.size = TABLE3.iter().find(|c| c.name == "B50").unwrap().sieve_curve();
+        assert_eq!(model_porosity(&b50, &mixture), None);
+        assert_eq!(model_porosity(&b50, &single).map(|p| p.equation), Some("Eq. 19".into()));
+        let mut u3 = table11();
+        u3.grains.size = TABLE3.iter().find(|c| c.name == "U3").unwrap().sieve_curve();
+        assert_eq!(model_porosity(&u3, &single), None);
+        let mut table7 = table11();
+        table7.process.shaking_duration = 1.0;
+        assert_eq!(model_porosity(&table7, &single), None);
     }
 }

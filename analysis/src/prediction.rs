@@ -170,14 +170,20 @@ pub fn input_from_grains(grains: &[(f64, f64)], description: &str) -> Result<Mod
             )));
         }
     }
-    let stats = grain_statistics(grains);
-    let (mut features, mut unavailable) = mixture_features(&stats);
-    if is_single_form_statistics(&stats) == Some(true) {
-        let (single, undefined) = single_form_features(&stats);
+    Ok(input_from_grain_statistics(&grain_statistics(grains), description))
+}
+
+/// Features from the number-based (mean, std) of every Table 1 factor over some grains (a
+/// packing's or measured ones): the 104 mixture features and, for one form, the 26 single-form
+/// features.
+pub fn input_from_grain_statistics(stats: &BTreeMap<String, (f64, f64)>, description: &str) -> ModelInput {
+    let (mut features, mut unavailable) = mixture_features(stats);
+    if is_single_form_statistics(stats) == Some(true) {
+        let (single, undefined) = single_form_features(stats);
         features.extend(single);
         unavailable.extend(undefined);
     }
-    Ok(ModelInput { source: InputSource::Grains, description: description.to_string(), features, unavailable })
+    ModelInput { source: InputSource::Grains, description: description.to_string(), features, unavailable }
 }
 
 /// (FL, EL) pairs from a CSV whose header names columns FL and EL (any case, any order, other

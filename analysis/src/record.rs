@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use solver::fabric::Imbrication;
 use solver::porosity::ProfilePoint;
 
-use crate::paper::PaperPorosity;
+use crate::paper::{ModelPorosity, PaperPorosity};
 
 /// A measured porosity to compare the simulated one with (Table 6).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -35,6 +35,10 @@ pub struct JobRecord {
     pub experiment: Option<Experiment>,
     /// The paper's simulated porosity, when the packing is one of its setups (Tables 5–8).
     pub paper: Option<PaperPorosity>,
+    /// The paper's porosity model at the grains' measured forms, when the packing is in the
+    /// models' setting (Eqs. 17–19, 23–24).
+    #[serde(default)]
+    pub paper_model: Option<ModelPorosity>,
     /// The fluid forces the packing was deposited with, in words ("drag, still water"); None:
     /// buoyancy only, the first paper's protocol.
     pub fluid: Option<String>,

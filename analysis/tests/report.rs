@@ -8,7 +8,7 @@ use analysis::analyse;
 use analysis::dataset::mixture_feature_names;
 use analysis::form_factors::{form_feature_names, grain_statistics};
 use analysis::model::LinearModel;
-use analysis::paper::PaperPorosity;
+use analysis::paper::{ModelPorosity, PaperPorosity};
 use analysis::record::{CampaignSummary, Cost, Experiment, JobRecord};
 use analysis::report::{ReportFiles, write_report};
 use analysis::selection::SelectionOptions;
@@ -74,6 +74,7 @@ fn mixture_campaign() -> Vec<JobRecord> {
                         size_case: None,
                         experiment: None,
                         paper: None,
+                        paper_model: None,
                         fluid: None,
                         imbrication: None,
                         setup: Vec::new(),
@@ -255,6 +256,7 @@ fn validation_campaign() -> Vec<JobRecord> {
                 size_case: None,
                 experiment: Some(experiment),
                 paper: None,
+                paper_model: None,
                 fluid: None,
                 imbrication: None,
                 setup: Vec::new(),
@@ -357,6 +359,39 @@ fn packings_of_the_papers_setups_are_compared_with_its_simulations() {
 }
 
 #[test]
+fn packings_in_the_models_setting_are_compared_with_the_papers_model() {
+    // Two runs of a form mixture (Eq. 23 at each run's measured forms: 0.356 and 0.358) and one
+    // of the two scans' own forms, whose σ_EL lies far below the paper's.
+    let mut records: Vec<JobRecord> = validation_campaign().into_iter().take(3).collect();
+    let eq23 = |porosity: f64, caveat: Option<&str>| ModelPorosity {
+        model: "paper-U1".into(),
+        equation: "Eq. 23".into(),
+        porosity,
+        caveat: caveat.map(String::from),
+    };
+    let runs = [(0.360, eq23(0.356, None)), (0.364, eq23(0.358, None)), (0.366, eq23(0.373, Some("σ_EL = 0.006")))];
+    for (r, (n, model)) in records.iter_mut().zip(runs) {
+        (r.porosity, r.experiment, r.paper_model) = (n, None, Some(model));
+    }
+    records[2].parameters.insert("grains.form".into(), serde_json::json!("own"));
+    let out = tempfile::tempdir().unwrap();
+    let md = std::fs::read_to_string(report("validation", &records, out.path()).markdown).unwrap();
+    let section = &md[md.find("## Comparison with the paper's porosity models").expect(&md)..];
+    // Mean 0.362, population std 0.002; model mean 0.357; 0.362 − 0.357 = 0.005.
+    assert!(section.contains("| grains.size = U1 | 0.360, 0.364 | 0.362 ± 0.002 | 0.357 | Eq. 23 | 0.005 |"), "{md}");
+    // 0.366 − 0.373 = −0.007, with the caveat beside the equation.
+    assert!(section.contains("| 0.366 | 0.366 | 0.373 | Eq. 23, extrapolated: σ_EL = 0.006 | -0.007 |"), "{md}");
+    // (0.005 + 0.007) / 2 = 0.006.
+    assert!(section.contains("Mean absolute difference over 2 setups: 0.0060."), "{md}");
+    // Without a model, no section.
+    for r in &mut records {
+        r.paper_model = None;
+    }
+    let md = std::fs::read_to_string(report("validation", &records, out.path()).markdown).unwrap();
+    assert!(!md.contains("porosity models"), "{md}");
+}
+
+#[test]
 fn a_model_fitted_to_few_packings_comes_with_a_plain_warning() {
     let records: Vec<JobRecord> = mixture_campaign().into_iter().step_by(4).take(8).collect();
     let out = tempfile::tempdir().unwrap();
@@ -420,6 +455,7 @@ fn shape_records(size_case: Option<&str>) -> Vec<JobRecord> {
                 size_case: size_case.map(String::from),
                 experiment: None,
                 paper: None,
+                paper_model: None,
                 fluid: None,
                 imbrication: None,
                 setup: Vec::new(),
@@ -520,6 +556,7 @@ fn a_campaign_with_and_without_drag_compares_them_seed_by_seed() {
                 size_case: None,
                 experiment: None,
                 paper: None,
+                paper_model: None,
                 fluid: fluid.map(String::from),
                 imbrication: None,
                 setup: Vec::new(),
@@ -576,6 +613,7 @@ fn the_imbrication_of_each_setup_is_summed_over_its_runs() {
                 size_case: None,
                 experiment: None,
                 paper: None,
+                paper_model: None,
                 fluid: Some(fluid.into()),
                 imbrication: Some(f),
                 setup: Vec::new(),

@@ -4,7 +4,7 @@
 
 use std::collections::BTreeMap;
 
-use analysis::paper::simulated_porosity;
+use analysis::paper::{model_porosity, simulated_porosity};
 use analysis::record::Cost;
 use analysis::{CampaignSummary, Experiment, JobRecord};
 use anyhow::Context;
@@ -203,19 +203,18 @@ pub fn job_record(row: &ExportRow, spec: Option<&PackingSpec>) -> anyhow::Result
         .map(serde_json::from_value)
         .transpose()
         .with_context(|| format!("job {}: the stored imbrication is not sedpack's", row.job_id))?;
+    let grain_statistics: BTreeMap<_, _> =
+        row.grain_statistics.iter().map(|s| (s.name.clone(), (s.mean, s.std))).collect();
     Ok(Some(JobRecord {
         job_id: row.job_id.clone(),
         porosity: result.porosity,
         profile,
         parameters: row.parameters.iter().map(|(k, v)| (k.clone(), v.clone())).collect(),
-        grain_statistics: row
-            .grain_statistics
-            .iter()
-            .map(|s| (s.name.clone(), (s.mean, s.std)))
-            .collect::<BTreeMap<_, _>>(),
         size_case: spec.and_then(|s| s.grains.size.case()).map(|c| c.name.to_string()),
         experiment: row.experiment_porosity.map(|porosity| Experiment { porosity, std: row.experiment_std }),
         paper: spec.and_then(simulated_porosity),
+        paper_model: spec.and_then(|s| model_porosity(s, &grain_statistics)),
+        grain_statistics,
         fluid: fluid.map(|f| f.describe()),
         imbrication,
         setup: spec.map(setup).unwrap_or_default(),
@@ -348,5 +347,23 @@ mod tests {
         assert_eq!(record.fluid.as_deref(), Some("drag and lift, logarithmic current, u* = 0.05 m/s, z₀ = 0.0002 m"));
         let error = job_record(&ExportRow { fluid: Some(json!({"flow": 1})), ..row(json!([])) }, None).unwrap_err();
         assert!(error.to_string().contains("stored fluid"), "{error}");
+    }
+
+    #[test]
+    fn a_packing_in_the_models_setting_reads_back_with_the_papers_model_at_its_grains() {
+        use solver::packing::DomainKind;
+        // Forms with FL and EL spread: Eq. 23 needs μ_EQ, σ_EQ and μ_EL. μ_EQ = 0.5, σ_EQ = 0.1,
+        // μ_EL = 0.8 give 0.032·2 − 0.003·10 + 0.011·1.25 + 0.287 = 0.33475.
+        let stats = [("FL", 0.6, 0.15), ("EL", 0.8, 0.12), ("EQ", 0.5, 0.1)];
+        let grains = stats.map(|(name, mean, std)| GrainStatistic { name: name.into(), mean, std }).to_vec();
+        let row = ExportRow { grain_statistics: grains, ..row(json!([])) };
+        let mut spec = PackingSpec::paper(DomainKind::Periodic);
+        spec.grains.shape = ShapeKind::Mesh;
+        let model = job_record(&row, Some(&spec)).unwrap().unwrap().paper_model.expect("in the models' setting");
+        assert_eq!(model.equation, "Eq. 23");
+        assert!((model.porosity - 0.33475).abs() < 1e-12, "{}", model.porosity);
+        // Ellipsoids are not what the models were fitted to.
+        spec.grains.shape = ShapeKind::Ellipsoid;
+        assert_eq!(job_record(&row, Some(&spec)).unwrap().unwrap().paper_model, None);
     }
 }

@@ -172,6 +172,9 @@ fn table_11_draws_the_rhine_forms_and_the_scans_study_is_the_packing_it_ran_befo
         same.grains.form = FormSpec::Own;
         same.contact_point = ContactPoint::CentreOfPressure;
         assert_eq!(same, own.spec.packing, "the two differ by the form and the contact point alone");
+        // Both are in the setting of the paper's models, so their reports compare them with Eq. 23.
+        assert!(analysis::paper::in_model_setting(&drawn.spec.packing));
+        assert!(analysis::paper::in_model_setting(&own.spec.packing));
     }
     // The job that validation-rhine-forms.yaml stored for seed 1 before it had its `form:` key
     // (sedpack 3268e0c, 2026-12-03, id b59357dd4a9c6c64), as the database holds it: the scans

@@ -62,6 +62,7 @@ pub fn write_report(
     setups_section(&mut blocks, records);
     experiment_section(&mut blocks, records);
     paper_section(&mut blocks, records);
+    model_section(&mut blocks, records);
     shape_section(&mut blocks, records)?;
     fluid_section(&mut blocks, records);
     match (dataset, selection) {
@@ -410,6 +411,37 @@ fn paper_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
                 None => format!("{:.3}", paper.porosity),
             };
             (paper.porosity, vec![shown, paper.table.clone(), format!("{:.3}", mean - paper.porosity)])
+        },
+    );
+}
+
+/// Eqs. 17–19 and 23–24: the runs of each setup in the setting of the paper's porosity models
+/// against the model of their case at their grains' measured forms.
+fn model_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
+    // Per setup: the runs' mean prediction, the equation and a caveat of some run.
+    type Model = (f64, String, Option<String>);
+    let groups: Vec<((String, Model), Vec<&JobRecord>)> =
+        grouped(records, |r| Some((setup_label(r), r.paper_model.as_ref()?.model.clone())))
+            .into_iter()
+            .map(|((label, _), runs)| {
+                let models: Vec<_> = runs.iter().filter_map(|r| r.paper_model.as_ref()).collect();
+                let mean = models.iter().map(|m| m.porosity).sum::<f64>() / models.len() as f64;
+                let caveat = models.iter().find_map(|m| m.caveat.clone());
+                ((label, (mean, models[0].equation.clone(), caveat)), runs)
+            })
+            .collect();
+    comparison(
+        blocks,
+        "Comparison with the paper's porosity models",
+        "The runs of each setup in the setting of the paper's porosity models (meshes in the periodic domain shaken t_s = 6 s by the paper's protocol, of a Table 3 case with a model: single forms of U1, U7 and B50, Eqs. 17–19, form mixtures of U1 and U7, Eqs. 23–24; width and mass may differ from the paper's 0.2 m and 16 kg), their mean and standard deviation, the model of their case at their grains' measured form statistics (the mean over the runs) and the difference sedpack − model. The models' own mean absolute errors in the paper's 10-fold cross-validation: 0.005, 0.004 and 0.006 for Eqs. 17–19 (Table 9), 0.004 and 0.005 for Eqs. 23 and 24 (Table 10). The paper's own test of Eq. 23 (Table 11: U1, the Rhine form distribution, 0.356) simulated 0.356 with forms drawn from the distribution and 0.353 with its 63 scans keeping their own forms.",
+        ["sedpack n (mean ± std)", "paper's model n", "model", "difference"],
+        &groups,
+        |mean, (model, equation, caveat)| {
+            let named = match caveat {
+                Some(c) => format!("{equation}, extrapolated: {c}"),
+                None => equation.clone(),
+            };
+            (*model, vec![format!("{model:.3}"), named, format!("{:.3}", mean - model)])
         },
     );
 }
@@ -1206,6 +1238,7 @@ mod tests {
             size_case: None,
             experiment: None,
             paper: None,
+            paper_model: None,
             fluid: None,
             imbrication: None,
             setup: Vec::new(),

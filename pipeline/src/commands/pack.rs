@@ -5,7 +5,7 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use analysis::paper::{PaperPorosity, simulated_porosity};
+use analysis::paper::{ModelPorosity, PaperPorosity, model_porosity, simulated_porosity};
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
@@ -35,6 +35,8 @@ struct ResultFile<'a> {
     experiment: Option<analysis::Experiment>,
     /// The paper's simulated porosity, for one of its setups (Tables 5–8).
     paper: Option<PaperPorosity>,
+    /// The paper's porosity model at the grains' forms, in the models' setting (Eqs. 17–19, 23–24).
+    paper_model: Option<ModelPorosity>,
     statistics: Map<String, Value>,
     profile: &'a [solver::porosity::ProfilePoint],
     /// With fluid forces on: the long axes' fabric against the flow.
@@ -71,6 +73,10 @@ pub fn run(args: &PackArgs) -> anyhow::Result<()> {
     if let Some(p) = &record.paper {
         let std = p.std.map(|s| format!(" ± {s}")).unwrap_or_default();
         table.row("paper", format!("{:.4}{std} (simulated, {})", p.porosity, p.table));
+    }
+    if let Some(m) = &record.paper_model {
+        let caveat = m.caveat.as_ref().map(|c| format!("; {c}")).unwrap_or_default();
+        table.row("paper's model", format!("{:.4} ({} at these grains' forms{caveat})", m.porosity, m.equation));
     }
     table
         .row(
@@ -151,6 +157,10 @@ fn result_file<'a>(job: &'a JobSpec, result: &'a PackingResult) -> ResultFile<'a
         wall_time: result.wall_time.as_secs_f64(),
         experiment: job.experiment,
         paper: simulated_porosity(&job.packing),
+        paper_model: model_porosity(
+            &job.packing,
+            &result.statistics.iter().map(|s| (s.name.to_string(), (s.mean, s.std))).collect(),
+        ),
         statistics,
         profile: &result.porosity.profile,
         imbrication: result.imbrication.as_ref(),
