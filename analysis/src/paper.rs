@@ -2,11 +2,12 @@
 //! L/S = EQ⁻¹ and L/I = EL⁻¹) and form-mixture models (Eqs. 23–24, features built from the
 //! number-based mean and standard deviation of EQ and EL), what they give a packing in their
 //! setting, and the porosities the paper simulated for the setups of its calibration and
-//! validation (Tables 5–8).
+//! validation (Tables 5–8 and 11).
 
 use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
+use solver::grain::RHINE_FORMS;
 use solver::packing::{DomainKind, FormSpec, GrainSpec, PackingSpec, ShapeKind};
 
 use crate::dataset::is_single_form_statistics;
@@ -94,8 +95,8 @@ pub struct PaperPorosity {
     pub std: Option<f64>,
 }
 
-/// One simulated setup of Tables 5–8: domain, width L (m), total mass (kg), shaking duration
-/// t_s (s) and Table 3 case, with the porosity found.
+/// One simulated setup of Tables 5–8 and 11: domain, width L (m), total mass (kg), shaking
+/// duration t_s (s), Table 3 case and the meshes' forms, with the porosity found.
 struct Simulated {
     table: &'static str,
     kind: DomainKind,
@@ -103,13 +104,14 @@ struct Simulated {
     mass: f64,
     shaking: f64,
     case: &'static str,
+    form: FormSpec,
     porosity: f64,
     std: Option<f64>,
 }
 
 const fn cylinder(table: &'static str, shaking: f64, case: &'static str, porosity: f64, std: f64) -> Simulated {
-    let std = Some(std);
-    Simulated { table, kind: DomainKind::Cylinder, width: 0.104, mass: 3.0, shaking, case, porosity, std }
+    let (std, form) = (Some(std), FormSpec::Own);
+    Simulated { table, kind: DomainKind::Cylinder, width: 0.104, mass: 3.0, shaking, case, form, porosity, std }
 }
 
 const fn periodic(
@@ -121,15 +123,34 @@ const fn periodic(
     porosity: f64,
     std: Option<f64>,
 ) -> Simulated {
-    Simulated { table, kind: DomainKind::Periodic, width, mass, shaking, case, porosity, std }
+    let form = FormSpec::Own;
+    Simulated { table, kind: DomainKind::Periodic, width, mass, shaking, case, form, porosity, std }
 }
 
-/// Tables 5–8 as printed. Where two tables give the same setup (t_s = 1 s in Tables 5 and 6,
-/// and in Tables 7 and 8) they give the same value, and Table 6's or Table 7's row is listed.
+/// Table 11's "continuous" setup: the periodic default (0.2 m, 16 kg, t_s = 6 s) with the forms
+/// drawn from the Rhine distribution of Table 2.
+const fn rhine_forms(case: &'static str, porosity: f64) -> Simulated {
+    Simulated {
+        table: "Table 11",
+        kind: DomainKind::Periodic,
+        width: 0.2,
+        mass: 16.0,
+        shaking: 6.0,
+        case,
+        form: FormSpec::Distribution(RHINE_FORMS),
+        porosity,
+        std: None,
+    }
+}
+
+/// Tables 5–8 and 11 as printed. Where two tables give the same setup (t_s = 1 s in Tables 5
+/// and 6, and in Tables 7 and 8; Table 11's "discrete" U7 and Table 8's U7 at t_s = 6 s) they
+/// give the same value, and Table 6's, 7's or 8's row is listed. Table 11's "discrete" setup is
+/// the periodic default with the meshes' own forms.
 /// Table 4 (mesh resolution, t_s = 2 s) is left out: its meshes of ≤ 300 faces repeat Table 5's
 /// setup with another run (U7 0.310 against 0.309), and its coarser meshes were simplified by
 /// another tool than sedpack's.
-const SIMULATED: [Simulated; 29] = [
+const SIMULATED: [Simulated; 32] = [
     cylinder("Table 6", 1.0, "U1", 0.383, 0.002),
     cylinder("Table 6", 1.0, "U3", 0.369, 0.002),
     cylinder("Table 6", 1.0, "U5", 0.333, 0.002),
@@ -159,12 +180,15 @@ const SIMULATED: [Simulated; 29] = [
     periodic("Table 8", 0.2, 16.0, 6.0, "B50", 0.242, None),
     periodic("Table 8", 0.2, 16.0, 8.0, "U7", 0.281, None),
     periodic("Table 8", 0.2, 16.0, 8.0, "B50", 0.241, None),
+    periodic("Table 11", 0.2, 16.0, 6.0, "U1", 0.353, None),
+    rhine_forms("U1", 0.356),
+    rhine_forms("U7", 0.288),
 ];
 
-/// The paper's simulated porosity for the setup of `spec`, if it is one of Tables 5–8 run by
-/// the paper's protocol: the table's domain, width, mass, shaking duration and size case;
-/// meshes keeping their own forms (§5.1: any library, the paper's being its 63 Rhine scans);
-/// no fluid forces; and every other value of the protocol and the evaluation at the paper's
+/// The paper's simulated porosity for the setup of `spec`, if it is one of Tables 5–8 and 11
+/// run by the paper's protocol: the table's domain, width, mass, shaking duration and size
+/// case; meshes keeping their own forms (§5.1: any library, the paper's being its 63 Rhine
+/// scans) or, for Table 11, drawn from the Rhine distribution; no fluid forces; and every other value of the protocol and the evaluation at the paper's
 /// (`PackingSpec::paper`), the grid spacing and trim of its rules included. Only the seed, the
 /// domain height, the time limit, the meshes and the contact point of polyhedra (sedpack's
 /// centre of pressure or the paper's software's witness) may differ.
@@ -178,8 +202,9 @@ pub fn simulated_porosity(spec: &PackingSpec) -> Option<PaperPorosity> {
             && same(s.width, spec.domain.width())
             && same(s.mass, spec.grains.mass)
             && same(s.shaking, spec.process.shaking_duration)
+            && s.form == spec.grains.form
     })?;
-    follows_papers_protocol(spec, FormSpec::Own).then(|| PaperPorosity {
+    follows_papers_protocol(spec, row.form).then(|| PaperPorosity {
         table: row.table.to_string(),
         porosity: row.porosity,
         std: row.std,
@@ -305,7 +330,7 @@ mod tests {
 
     #[test]
     fn the_papers_setups_find_their_tables_row() {
-        // Values as printed in Tables 5–8 of the paper.
+        // Values as printed in Tables 5–8 and 11 of the paper.
         assert_eq!(found(&table7("U7")), Some(("Table 7".into(), 0.291, Some(0.001))));
         assert_eq!(found(&table7("B50")), Some(("Table 7".into(), 0.246, Some(0.005))));
         // The cylinder of §5.1 (0.104 m, 3 kg, t_s = 1 s) is Table 6's setup, for every case.
@@ -314,8 +339,22 @@ mod tests {
         let mut unshaken = meshes(DomainKind::Cylinder, "U7");
         unshaken.process.shaking_duration = 0.0;
         assert_eq!(found(&unshaken), Some(("Table 5".into(), 0.323, Some(0.001))));
-        // The periodic default (0.2 m, 16 kg, t_s = 6 s) is a column of Table 8, without spread.
+        // The periodic default (0.2 m, 16 kg, t_s = 6 s) is a column of Table 8, without spread,
+        // and for U1 Table 11's "discrete" run; with the Rhine forms drawn, its "continuous" one.
         assert_eq!(found(&meshes(DomainKind::Periodic, "U7")), Some(("Table 8".into(), 0.282, None)));
+        assert_eq!(found(&meshes(DomainKind::Periodic, "U1")), Some(("Table 11".into(), 0.353, None)));
+        let mut drawn = meshes(DomainKind::Periodic, "U1");
+        drawn.grains.form = FormSpec::Distribution(RHINE_FORMS);
+        assert_eq!(found(&drawn), Some(("Table 11".into(), 0.356, None)));
+        drawn.grains.size = TABLE3.iter().find(|c| c.name == "U7").unwrap().sieve_curve();
+        assert_eq!(found(&drawn), Some(("Table 11".into(), 0.288, None)));
+        // Another distribution, or Table 11's scaled down, is no setup of the paper's.
+        let mut other = drawn.clone();
+        other.grains.form = FormSpec::Distribution(solver::grain::FormDistribution { mu_fl: 0.5, ..RHINE_FORMS });
+        assert_eq!(found(&other), None);
+        drawn.domain = Domain::Periodic { width: 0.06 };
+        drawn.grains.mass = 1.44;
+        assert_eq!(found(&drawn), None);
     }
 
     #[test]

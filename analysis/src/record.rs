@@ -33,7 +33,7 @@ pub struct JobRecord {
     pub size_case: Option<String>,
     /// Measured porosity, when the campaign gives one.
     pub experiment: Option<Experiment>,
-    /// The paper's simulated porosity, when the packing is one of its setups (Tables 5–8).
+    /// The paper's simulated porosity, when the packing is one of its setups (Tables 5–8, 11).
     pub paper: Option<PaperPorosity>,
     /// The paper's porosity model at the grains' measured forms, when the packing is in the
     /// models' setting (Eqs. 17–19, 23–24).

@@ -397,12 +397,12 @@ fn experiment_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
     );
 }
 
-/// Tables 5–8: the runs of each setup the paper simulated against the paper's runs.
+/// Tables 5–8 and 11: the runs of each setup the paper simulated against the paper's runs.
 fn paper_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
     comparison(
         blocks,
         "Comparison with the paper's simulations",
-        "Like Tables 5–8: the runs of each setup that is one of the paper's simulated setups (the table's domain, width, mass, shaking duration t_s and Table 3 case, meshes keeping their own forms, no fluid forces, and the paper's protocol and evaluation otherwise; seed, domain height, time limit, meshes and the contact point of polyhedra may differ), their mean and standard deviation, the paper's porosity for the setup (the mean of its three runs ± their standard deviation, where the table gives one) and the difference sedpack − paper. The paper drew its grains from 63 scanned Rhine grains; a library of fewer meshes samples fewer shapes.",
+        "Like Tables 5–8 and 11: the runs of each setup that is one of the paper's simulated setups (the table's domain, width, mass, shaking duration t_s and Table 3 case, meshes keeping their own forms or, for Table 11, drawn from the Rhine distribution, no fluid forces, and the paper's protocol and evaluation otherwise; seed, domain height, time limit, meshes and the contact point of polyhedra may differ), their mean and standard deviation, the paper's porosity for the setup (the mean of its three runs ± their standard deviation, where the table gives one) and the difference sedpack − paper. The paper drew its grains from 63 scanned Rhine grains; a library of fewer meshes samples fewer shapes.",
         ["sedpack n (mean ± std)", "paper n (mean ± std)", "source", "difference"],
         &grouped(records, |r| Some((setup_label(r), r.paper.clone()?))),
         |mean, paper| {

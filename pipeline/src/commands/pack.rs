@@ -33,7 +33,7 @@ struct ResultFile<'a> {
     steps: u64,
     wall_time: f64,
     experiment: Option<analysis::Experiment>,
-    /// The paper's simulated porosity, for one of its setups (Tables 5–8).
+    /// The paper's simulated porosity, for one of its setups (Tables 5–8, 11).
     paper: Option<PaperPorosity>,
     /// The paper's porosity model at the grains' forms, in the models' setting (Eqs. 17–19, 23–24).
     paper_model: Option<ModelPorosity>,
