@@ -253,10 +253,15 @@ pub fn in_model_setting(spec: &PackingSpec) -> bool {
         && follows_papers_protocol(spec, spec.grains.form)
 }
 
-/// Half the smallest nominal standard deviation of FL and EL among the paper's form-mixture
-/// packings ({0.1, 0.2}, §7.1): their measured spreads lie somewhat below nominal (the redraw of
-/// out-of-range forms), so a model is said to extrapolate only well below.
-const SMALLEST_FITTED_SPREAD: f64 = 0.05;
+/// The nominal parameters of the paper's 52 form-mixture setups (§7.1): means of FL and EL in
+/// [0.4, 0.8], standard deviations in [0.1, 0.2]. Outside, the models extrapolate.
+pub const MIXTURE_MEANS: [f64; 2] = [0.4, 0.8];
+pub const MIXTURE_SIGMAS: [f64; 2] = [0.1, 0.2];
+
+/// Half the smallest nominal standard deviation: the measured spreads of the paper's packings lie
+/// somewhat below nominal (the redraw of out-of-range forms), so a model is said to extrapolate
+/// for a packing's measured forms only well below.
+const SMALLEST_FITTED_SPREAD: f64 = MIXTURE_SIGMAS[0] / 2.0;
 
 /// What the paper's porosity model of a packing's Table 3 case gives at its grains' measured
 /// form statistics.
@@ -295,8 +300,9 @@ pub fn model_porosity(spec: &PackingSpec, statistics: &BTreeMap<String, (f64, f6
         .collect();
     let caveat = (!single && !narrow.is_empty()).then(|| {
         format!(
-            "{}, far below the paper's smallest spread (0.1); the form-mixture model does not hold for vanishing spread (§7.2)",
-            narrow.join(", ")
+            "{}, far below the paper's smallest spread ({}); the form-mixture model does not hold for vanishing spread (§7.2)",
+            narrow.join(", "),
+            MIXTURE_SIGMAS[0]
         )
     });
     let equation = paper.model.campaign.unwrap_or_default().replace("Rettinger et al. (2022), ", "");

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use analysis::LinearModel;
-use analysis::paper::{PAPER_MODEL_NAMES, PaperModelKind, paper_model};
+use analysis::paper::{MIXTURE_MEANS, MIXTURE_SIGMAS, PAPER_MODEL_NAMES, PaperModelKind, paper_model};
 use analysis::prediction::{
     FormStatistics, input_from_grains, input_from_statistics, load_model, predict, read_grains_csv,
 };
@@ -13,11 +13,6 @@ use serde::Serialize;
 
 use crate::cli::PredictArgs;
 use crate::output::{Table, number, print_json};
-
-/// The nominal parameters of the paper's 52 form-mixture setups (§7.1): means in [0.4, 0.8],
-/// standard deviations in [0.1, 0.2]. Outside, the models extrapolate.
-const MIXTURE_MEANS: [f64; 2] = [0.4, 0.8];
-const MIXTURE_SIGMAS: [f64; 2] = [0.1, 0.2];
 
 #[derive(Serialize)]
 struct Output {
