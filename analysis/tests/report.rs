@@ -423,8 +423,12 @@ fn too_few_packings_still_give_a_report_that_says_why() {
     let files = report("tiny", &records, out.path());
     let md = std::fs::read_to_string(&files.markdown).unwrap();
     assert!(md.contains("No model could be built: too few finished jobs (2) to rank features"), "{md}");
+    assert!(md.contains("`dataset.csv` holds 2 rows (packings)"), "{md}");
     assert!(files.models.is_empty());
     check_html(out.path(), 1);
+    let one = report("one", &records[..1], out.path());
+    let md = std::fs::read_to_string(&one.markdown).unwrap();
+    assert!(md.contains("`dataset.csv` holds 1 row (packings)"), "the noun agrees with one packing: {md}");
 
     let empty = report("empty", &[], out.path());
     assert_eq!(std::fs::read_to_string(empty.dataset).unwrap(), "job_id,porosity\n");

@@ -93,6 +93,7 @@ fn the_table_6_and_7_campaigns_are_the_papers_setups() {
         ("campaigns/validation-pebbles.yaml", "Table 7", &[("U7", 0.291)][..]),
         ("campaigns/validation-pebbles-cylinder.yaml", "Table 6", &[("U1", 0.383)][..]),
         ("campaigns/validation-contact-point.yaml", "Table 6", &[("U1", 0.383), ("U7", 0.314)][..]),
+        ("campaigns/validation-periodic-witness.yaml", "Table 7", &[("U7", 0.291), ("B50", 0.246)][..]),
     ] {
         let campaign = sedpack::campaign::read_campaign(repo(file).as_ref()).unwrap();
         assert_eq!(campaign.jobs.len(), 3 * rows.len(), "{file}");
@@ -134,26 +135,37 @@ fn the_shaking_study_is_table_5s_u7_and_table_6s_u7_but_for_t_s() {
 }
 
 #[test]
-fn the_contact_point_study_is_table_6_u1_and_u7_with_only_the_contact_point_changed() {
+fn the_contact_point_studies_are_tables_6_and_7_with_only_the_contact_point_changed() {
     use solver::dem::ContactPoint;
-    let study = sedpack::campaign::read_campaign(repo("campaigns/validation-contact-point.yaml").as_ref()).unwrap();
-    let table6 = sedpack::campaign::read_campaign(repo("campaigns/validation-cylinder.yaml").as_ref()).unwrap();
-    assert_eq!(study.jobs.len(), 6);
-    for job in &study.jobs {
-        let case = job.spec.packing.grains.size.case().map(|c| c.name);
-        let witness = &job.spec.packing;
-        assert_eq!(witness.contact_point, ContactPoint::Witness);
-        assert_eq!(sedpack::stored::format(&job.spec), 4);
-        let centre = table6
-            .jobs
-            .iter()
-            .map(|j| &j.spec.packing)
-            .find(|p| p.seed == witness.seed && p.grains.size.case().map(|c| c.name) == case)
-            .unwrap();
-        let mut same = witness.clone();
-        same.contact_point = ContactPoint::CentreOfPressure;
-        assert_eq!(&same, centre, "{case:?}, seed {}", witness.seed);
+    for (file, reference, jobs) in [
+        ("campaigns/validation-contact-point.yaml", "campaigns/validation-cylinder.yaml", 6),
+        ("campaigns/validation-periodic-witness.yaml", "campaigns/validation-periodic.yaml", 6),
+    ] {
+        let study = sedpack::campaign::read_campaign(repo(file).as_ref()).unwrap();
+        let reference = sedpack::campaign::read_campaign(repo(reference).as_ref()).unwrap();
+        assert_eq!(study.jobs.len(), jobs, "{file}");
+        for job in &study.jobs {
+            let case = job.spec.packing.grains.size.case().map(|c| c.name);
+            let witness = &job.spec.packing;
+            assert_eq!(witness.contact_point, ContactPoint::Witness);
+            assert_eq!(sedpack::stored::format(&job.spec), 4);
+            let centre = reference
+                .jobs
+                .iter()
+                .map(|j| &j.spec.packing)
+                .find(|p| p.seed == witness.seed && p.grains.size.case().map(|c| c.name) == case)
+                .unwrap();
+            let mut same = witness.clone();
+            same.contact_point = ContactPoint::CentreOfPressure;
+            assert_eq!(&same, centre, "{file}: {case:?}, seed {}", witness.seed);
+        }
     }
+    // U7's seeds come before B50's: Table 7's three seeds of U7 fit before the long B50 packings.
+    let periodic =
+        sedpack::campaign::read_campaign(repo("campaigns/validation-periodic-witness.yaml").as_ref()).unwrap();
+    let order: Vec<(&str, u64)> =
+        periodic.jobs.iter().map(|j| (j.spec.packing.grains.size.case().unwrap().name, j.spec.packing.seed)).collect();
+    assert_eq!(order[..4], [("U7", 1), ("U7", 2), ("U7", 3), ("B50", 1)]);
 }
 
 #[test]

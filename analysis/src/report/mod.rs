@@ -476,7 +476,7 @@ fn comparison<R>(
         .push(Block::Table { header: ["setup", "runs"].into_iter().chain(columns).map(String::from).collect(), rows });
     blocks.push(Block::Paragraph(format!(
         "Mean absolute difference over {}: {:.4}.",
-        setup_count(differences.len()),
+        counted(differences.len(), "setup"),
         differences.iter().sum::<f64>() / differences.len() as f64
     )));
 }
@@ -504,9 +504,9 @@ fn grouped<K: PartialEq>(records: &[JobRecord], key: impl Fn(&JobRecord) -> Opti
     groups
 }
 
-/// "1 setup", "2 setups".
-fn setup_count(n: usize) -> String {
-    format!("{n} setup{}", if n == 1 { "" } else { "s" })
+/// "1 setup", "2 setups": a count with its noun agreed.
+fn counted(n: usize, noun: &str) -> String {
+    format!("{n} {noun}{}", if n == 1 { "" } else { "s" })
 }
 
 /// Mean and population standard deviation.
@@ -659,7 +659,7 @@ fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), R
             "RMS difference `{}` − `{}` over {}: {:.4}.",
             shapes[k],
             shapes[0],
-            setup_count(sq.len()),
+            counted(sq.len(), "setup"),
             (sq.iter().sum::<f64>() / sq.len() as f64).sqrt()
         )));
     }
@@ -674,7 +674,7 @@ fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), R
                     "`{shape}` {:+.4} on average, mean absolute difference {:.4} ({})",
                     d.iter().sum::<f64>() / n,
                     d.iter().map(|x| x.abs()).sum::<f64>() / n,
-                    setup_count(d.len())
+                    counted(d.len(), "setup")
                 )
             })
             .collect();
@@ -905,8 +905,8 @@ fn imbrication_row(setup: &str, fluid: &str, fabrics: &[&Imbrication]) -> Vec<St
 fn dataset_section(blocks: &mut Vec<Block>, d: &Dataset) {
     blocks.push(Block::Heading("Dataset".into()));
     blocks.push(Block::Paragraph(format!(
-        "`dataset.csv` holds {} rows (packings) and {} feature columns ({}), besides `job_id` and `porosity`.",
-        d.len(),
+        "`dataset.csv` holds {} (packings) and {} feature columns ({}), besides `job_id` and `porosity`.",
+        counted(d.len(), "row"),
         d.features().len(),
         d.kind().describe()
     )));
