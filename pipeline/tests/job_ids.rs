@@ -137,13 +137,13 @@ fn the_shaking_study_is_table_5s_u7_and_table_6s_u7_but_for_t_s() {
 #[test]
 fn the_contact_point_studies_are_tables_6_and_7_with_only_the_contact_point_changed() {
     use solver::dem::ContactPoint;
-    for (file, reference, jobs) in [
-        ("campaigns/validation-contact-point.yaml", "campaigns/validation-cylinder.yaml", 6),
-        ("campaigns/validation-periodic-witness.yaml", "campaigns/validation-periodic.yaml", 6),
+    for (file, reference) in [
+        ("campaigns/validation-contact-point.yaml", "campaigns/validation-cylinder.yaml"),
+        ("campaigns/validation-periodic-witness.yaml", "campaigns/validation-periodic.yaml"),
     ] {
         let study = sedpack::campaign::read_campaign(repo(file).as_ref()).unwrap();
         let reference = sedpack::campaign::read_campaign(repo(reference).as_ref()).unwrap();
-        assert_eq!(study.jobs.len(), jobs, "{file}");
+        assert_eq!(study.jobs.len(), 6, "{file}");
         for job in &study.jobs {
             let case = job.spec.packing.grains.size.case().map(|c| c.name);
             let witness = &job.spec.packing;
