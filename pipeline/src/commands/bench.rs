@@ -18,7 +18,7 @@ use crate::output::{number, print_json};
 
 /// Bumped whenever a cached bed of an earlier build should no longer be used. Beds are stored as
 /// JSON, so one whose layout no longer matches fails to read and is built again.
-const BED_FORMAT: u32 = 6;
+const BED_FORMAT: u32 = 7;
 /// The shaking of §4.3 (Eq. 14): amplitude 3e-4 m, period 0.025 s.
 const SHAKING: Shaking = Shaking { amplitude: 3e-4, period: 0.025 };
 /// Steps run before the clock starts, so that caches are warm and contacts cached.

@@ -1,7 +1,9 @@
 //! Broad phase: linked cells (with periodic images) build a Verlet list of body pairs whose
-//! bounding spheres come within a skin distance; the list is reused until some body has moved
-//! more than half the skin, and each pair carries its contact history and narrow-phase cache
-//! across rebuilds.
+//! bounding spheres come within the sum of their shares of the skin; the list is reused until
+//! some body has moved more than its share, and each pair carries its contact history and
+//! narrow-phase cache across rebuilds. A body's share is half the skin, or more for a fast one
+//! (a grain raining down): the distance it covers in a fixed horizon, so that one falling grain
+//! does not force a rebuild of the whole list every few dozen steps.
 //!
 //! The list is simulation state (a checkpoint keeps it); the cell grid and the previous list a
 //! rebuild works with are scratch ([`BuildScratch`]), owned by the step pipeline.
@@ -35,14 +37,18 @@ pub struct Pair {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct NeighbourList {
     skin: f64,
+    /// The time ahead a body's share of the skin covers at its velocity at the build (s).
+    horizon: f64,
     /// Sorted by (i, j, contact key, pieces): a body's pairs as i are contiguous.
     pub pairs: Vec<Pair>,
     /// The contact history of each pair.
     pub history: Vec<ContactHistory>,
     /// What the narrow phase keeps of each pair.
     pub cache: Vec<PairCache>,
-    /// Positions at the last build; rebuilding is due once a body has moved skin/2 from here.
+    /// Positions at the last build; rebuilding is due once a body has moved its share from here.
     reference: Vec<Vector3<f64>>,
+    /// Each body's share of the skin since the last build: between skin/2 and 2 skin.
+    shares: Vec<f64>,
     /// Orientations at the last build: the pieces of a bonded grain also move by turning.
     reference_orientation: Vec<UnitQuaternion<f64>>,
     /// Whole periods each body has been moved back into the box by since the start; a pair's
@@ -67,6 +73,8 @@ pub struct BuildScratch {
     /// The bodies of each cell with what the pair search reads of them, cell after cell.
     cell_bodies: Vec<Member>,
     cell_of: Vec<usize>,
+    /// The smallest and the largest bounding radius among each cell's bodies.
+    cell_radii: Vec<[f64; 2]>,
     fill: Vec<u32>,
     old_pairs: Vec<Pair>,
     old_history: Vec<ContactHistory>,
@@ -80,6 +88,7 @@ pub struct BuildScratch {
 struct Member {
     body: u32,
     radius: f64,
+    share: f64,
     position: Vector3<f64>,
 }
 
@@ -119,9 +128,10 @@ impl Grid {
         self.n.iter().product()
     }
 
-    /// The cells along axis `k` within `reach` of a point in cell `c`, each once: a periodic axis
-    /// wraps around (all its cells once the reach spans it), a bounded one stops at its ends.
-    fn axis(&self, k: usize, c: usize, reach: f64) -> impl Iterator<Item = usize> + use<> {
+    /// The cells along axis `k` within `reach` of a point at `p` in cell `c`, each once, with
+    /// the squared gap from `p` to the cell's slab (to its nearest periodic image): a periodic
+    /// axis wraps around (all its cells once the reach spans it), a bounded one stops at its ends.
+    fn axis(&self, k: usize, p: f64, c: usize, reach: f64) -> impl Iterator<Item = (usize, f64)> + use<> {
         let (n, c, span) = (self.n[k] as i64, c as i64, (reach / self.width[k]).ceil() as i64);
         let wraps = self.periodic && k < 2;
         let (lo, hi) = match wraps {
@@ -129,27 +139,42 @@ impl Grid {
             true => (c - span, c + span),
             false => ((c - span).max(0), (c + span).min(n - 1)),
         };
+        let (w, period) = (self.width[k], self.width[k] * n as f64);
+        let local = p - self.origin[k];
+        let slab_gap = move |start: f64| (start - local).max(local - start - w).max(0.0);
         // The wrapped range reaches less than one period past either end.
         (lo..=hi).map(move |v| {
-            (if v < 0 {
+            let start = v as f64 * w;
+            let gap = match wraps {
+                true => slab_gap(start).min(slab_gap(start - period)).min(slab_gap(start + period)),
+                false => slab_gap(start),
+            };
+            // Shrunk by a rounding's worth: a member sits in its slab up to the rounding of `coordinates`.
+            let gap = (gap - 1e-9 * w).max(0.0);
+            let wrapped = if v < 0 {
                 v + n
             } else if v >= n {
                 v - n
             } else {
                 v
-            }) as usize
+            };
+            (wrapped as usize, gap * gap)
         })
     }
 }
 
 impl NeighbourList {
-    pub fn new(skin: f64) -> Self {
+    /// A list with Verlet skin `skin` whose fast bodies' shares cover `horizon` seconds of
+    /// their motion (0: every share is skin/2, the classic list).
+    pub fn new(skin: f64, horizon: f64) -> Self {
         Self {
             skin,
+            horizon,
             pairs: Vec::new(),
             history: Vec::new(),
             cache: Vec::new(),
             reference: Vec::new(),
+            shares: Vec::new(),
             reference_orientation: Vec::new(),
             wraps: Vec::new(),
             first_as_i: vec![0],
@@ -163,21 +188,21 @@ impl NeighbourList {
         self.skin
     }
 
-    /// A rebuild is due when bodies were added or a piece moved more than half the skin, the
-    /// most two pieces can approach each other without the list noticing. A bonded grain's
-    /// pieces move by at most |Δx| + r θ for a turn by θ.
+    /// A rebuild is due when bodies were added or a piece moved more than its body's share of
+    /// the skin: two pieces unlisted were at least the sum of their shares apart, so neither
+    /// moving further than its share, they cannot touch. A bonded grain's pieces move by at
+    /// most |Δx| + r θ for a turn by θ.
     pub fn is_stale(&self, bodies: &Bodies) -> bool {
         if self.reference.len() != bodies.len() {
             return true;
         }
-        let limit = 0.25 * self.skin * self.skin;
         (0..bodies.len()).any(|k| {
-            let shift2 = (bodies.position[k] - self.reference[k]).norm_squared();
+            let (shift2, share) = ((bodies.position[k] - self.reference[k]).norm_squared(), self.shares[k]);
             if bodies.shape[k].pieces() == 1 {
-                return shift2 > limit;
+                return shift2 > share * share;
             }
             let turn = bodies.orientation[k].angle_to(&self.reference_orientation[k]);
-            shift2.sqrt() + bodies.bounding_radius[k] * turn > 0.5 * self.skin
+            shift2.sqrt() + bodies.bounding_radius[k] * turn > share
         })
     }
 
@@ -185,6 +210,7 @@ impl NeighbourList {
     pub fn body_bytes(&self) -> usize {
         use std::mem::size_of_val;
         size_of_val(&self.reference[..])
+            + size_of_val(&self.shares[..])
             + size_of_val(&self.reference_orientation[..])
             + size_of_val(&self.wraps[..])
             + size_of_val(&self.first_as_i[..])
@@ -226,8 +252,11 @@ impl NeighbourList {
         scratch.old_keys.clear();
         scratch.old_keys.extend(self.pairs.iter().map(|p| contact_key(p, &self.wraps)));
         self.wrap(bodies, domain);
+        let (least, most) = (0.5 * self.skin, 2.0 * self.skin);
+        self.shares.clear();
+        self.shares.extend(bodies.velocity.iter().map(|v| (v.norm() * self.horizon).clamp(least, most)));
         let grid = self.grid(bodies, domain, &mut scratch.radii)?;
-        scratch.bin(bodies, &grid);
+        scratch.bin(bodies, &self.shares, &grid);
         std::mem::swap(&mut self.pairs, &mut scratch.old_pairs);
         std::mem::swap(&mut self.history, &mut scratch.old_history);
         std::mem::swap(&mut self.cache, &mut scratch.old_cache);
@@ -255,7 +284,7 @@ impl NeighbourList {
     /// reach (twice its bounding radius plus the skin), but no more than a few cells per body.
     fn grid(&self, bodies: &Bodies, domain: &Domain, radii: &mut Vec<f64>) -> Result<Grid, SolverError> {
         let r_max = bodies.bounding_radius.iter().cloned().fold(0.0, f64::max);
-        let cutoff = 2.0 * r_max + self.skin;
+        let cutoff = 2.0 * (r_max + self.largest_share());
         // A grain must not reach its own periodic image; up to that, a pair may touch through
         // two images at once and both are listed.
         if domain.is_periodic() && cutoff >= domain.width() {
@@ -274,19 +303,32 @@ impl NeighbourList {
         Ok(Grid::new(domain, (2.0 * median + self.skin).max(sparse), z_range))
     }
 
+    /// The largest share of the skin of the last build.
+    fn largest_share(&self) -> f64 {
+        self.shares.iter().cloned().fold(0.0, f64::max)
+    }
+
     /// Every pair of pieces within reach, in the order (i, j, contact key, pieces). Each body
     /// looks for the partners no larger than itself (ties to the lower index) in the cells its
     /// reach spans, so that a few large grains do not make every small one search their range.
     fn list_pairs(&mut self, bodies: &Bodies, domain: &Domain, grid: &Grid, s: &BuildScratch) {
         self.pairs.clear();
-        let radius = &bodies.bounding_radius;
+        let (radius, most) = (&bodies.bounding_radius, self.largest_share());
         for (i, (&xi, &ri)) in bodies.position.iter().zip(radius).enumerate() {
             let ci = grid.coordinates(&xi);
-            let search = 2.0 * ri + self.skin;
-            for cz in grid.axis(2, ci[2], search) {
-                for cy in grid.axis(1, ci[1], search) {
-                    for cx in grid.axis(0, ci[0], search) {
+            let si = self.shares[i];
+            let search = 2.0 * ri + si + most;
+            for (cz, gz) in grid.axis(2, xi.z, ci[2], search) {
+                for (cy, gy) in grid.axis(1, xi.y, ci[1], search) {
+                    for (cx, gx) in grid.axis(0, xi.x, ci[0], search) {
                         let c = grid.index([cx, cy, cz]);
+                        // Skip a cell none of whose members is both no larger than i and within
+                        // reach of it: a large grain's search spans many cells of small ones.
+                        let [smallest, largest] = s.cell_radii[c];
+                        let cell_reach = ri + largest + si + most;
+                        if smallest > ri || gx + gy + gz >= cell_reach * cell_reach {
+                            continue;
+                        }
                         for m in &s.cell_bodies[s.cell_start[c] as usize..s.cell_start[c + 1] as usize] {
                             let other = m.body as usize;
                             if m.radius > ri || (m.radius == ri && other <= i) {
@@ -294,7 +336,7 @@ impl NeighbourList {
                             }
                             // Positions are wrapped into the box; beyond reach of the nearest
                             // image, every image is.
-                            let reach = ri + m.radius + self.skin;
+                            let reach = ri + m.radius + si + m.share;
                             if domain.nearest_distance2(&xi, &m.position) < reach * reach {
                                 self.list_pair(bodies, domain, i.min(other), i.max(other));
                             }
@@ -310,7 +352,8 @@ impl NeighbourList {
     /// Lists bodies i < j for every periodic image of j within reach of i.
     fn list_pair(&mut self, bodies: &Bodies, domain: &Domain, i: usize, j: usize) {
         let xi = bodies.position[i];
-        let reach = bodies.bounding_radius[i] + bodies.bounding_radius[j] + self.skin;
+        let shares = self.shares[i] + self.shares[j];
+        let reach = bodies.bounding_radius[i] + bodies.bounding_radius[j] + shares;
         let (mi, mj) = (bodies.mass[i], bodies.mass[j]);
         let effective_mass = mi * mj / (mi + mj);
         for image in domain.images_within(&xi, &bodies.position[j], reach) {
@@ -319,7 +362,7 @@ impl NeighbourList {
                 let spheres =
                     matches!((&bodies.shape[i], &bodies.shape[j]), (Shape::Sphere { .. }, Shape::Sphere { .. }));
                 let body_pair = Pair { i: i as u32, j: j as u32, image, pieces: [0, 0], spheres, effective_mass };
-                push_piece_pairs(&mut self.pairs, body_pair, bodies, xj, self.skin);
+                push_piece_pairs(&mut self.pairs, body_pair, bodies, xj, shares);
             }
         }
     }
@@ -374,13 +417,17 @@ impl NeighbourList {
 
 impl BuildScratch {
     /// Counting sort of the bodies into the grid's cells.
-    fn bin(&mut self, bodies: &Bodies, grid: &Grid) {
+    fn bin(&mut self, bodies: &Bodies, shares: &[f64], grid: &Grid) {
         self.cell_of.clear();
         self.cell_of.extend(bodies.position.iter().map(|p| grid.index(grid.coordinates(p))));
         self.cell_start.clear();
         self.cell_start.resize(grid.count() + 1, 0);
-        for &c in &self.cell_of {
+        self.cell_radii.clear();
+        self.cell_radii.resize(grid.count(), [f64::INFINITY, f64::NEG_INFINITY]);
+        for (&c, &r) in self.cell_of.iter().zip(&bodies.bounding_radius) {
             self.cell_start[c + 1] += 1;
+            let radii = &mut self.cell_radii[c];
+            *radii = [radii[0].min(r), radii[1].max(r)];
         }
         for c in 0..grid.count() {
             self.cell_start[c + 1] += self.cell_start[c];
@@ -389,16 +436,17 @@ impl BuildScratch {
         self.cell_bodies.resize(bodies.len(), Member::default());
         self.fill.clone_from(&self.cell_start);
         for (b, &c) in self.cell_of.iter().enumerate() {
-            let (radius, position) = (bodies.bounding_radius[b], bodies.position[b]);
-            self.cell_bodies[self.fill[c] as usize] = Member { body: b as u32, radius, position };
+            let (radius, share, position) = (bodies.bounding_radius[b], shares[b], bodies.position[b]);
+            self.cell_bodies[self.fill[c] as usize] = Member { body: b as u32, radius, share, position };
             self.fill[c] += 1;
         }
     }
 }
 
-/// The piece pairs of a body pair whose pieces come within the skin: the one pair of two convex
-/// grains, those of nearby component spheres when a grain is bonded.
-fn push_piece_pairs(pairs: &mut Vec<Pair>, body_pair: Pair, bodies: &Bodies, xj: Vector3<f64>, skin: f64) {
+/// The piece pairs of a body pair whose pieces come within `shares` (the bodies' shares of the
+/// skin): the one pair of two convex grains, those of nearby component spheres when a grain is
+/// bonded.
+fn push_piece_pairs(pairs: &mut Vec<Pair>, body_pair: Pair, bodies: &Bodies, xj: Vector3<f64>, shares: f64) {
     let (i, j) = (body_pair.i as usize, body_pair.j as usize);
     let (si, sj) = (&bodies.shape[i], &bodies.shape[j]);
     if si.pieces() == 1 && sj.pieces() == 1 {
@@ -410,7 +458,7 @@ fn push_piece_pairs(pairs: &mut Vec<Pair>, body_pair: Pair, bodies: &Bodies, xj:
         let ca = bodies.position[i] + bodies.orientation[i] * ca;
         for kb in 0..sj.pieces() {
             let (cb, rb) = sj.piece_bounds(kb);
-            let reach = ra + rb + skin;
+            let reach = ra + rb + shares;
             if (xj + bodies.orientation[j] * cb - ca).norm_squared() < reach * reach {
                 pairs.push(Pair { pieces: [ka as u16, kb as u16], ..body_pair });
             }
@@ -448,12 +496,14 @@ mod tests {
         b
     }
 
-    /// Every pair within reach by brute force: each pair of bodies, each periodic image.
-    fn all_pairs_within_reach(b: &Bodies, domain: &Domain, skin: f64) -> Vec<(u32, u32, [i16; 2])> {
+    /// Every pair within reach by brute force: each pair of bodies, each periodic image; a
+    /// body's share of the skin is what its speed covers in `horizon`, from skin/2 to 2 skin.
+    fn all_pairs_within_reach(b: &Bodies, domain: &Domain, skin: f64, horizon: f64) -> Vec<(u32, u32, [i16; 2])> {
+        let share = |k: usize| (b.velocity[k].norm() * horizon).max(0.5 * skin).min(2.0 * skin);
         let mut expected = Vec::new();
         for i in 0..b.len() {
             for j in i + 1..b.len() {
-                let reach = b.bounding_radius[i] + b.bounding_radius[j] + skin;
+                let reach = b.bounding_radius[i] + b.bounding_radius[j] + share(i) + share(j);
                 for image in [-1i16, 0, 1].iter().flat_map(|&x| [-1i16, 0, 1].map(|y| [x, y])) {
                     let shift = if domain.is_periodic() { domain.shift(image) } else { Vector3::zeros() };
                     if (domain.is_periodic() || image == [0, 0])
@@ -471,30 +521,35 @@ mod tests {
     #[test]
     fn grains_of_widely_different_sizes_get_every_pair_within_reach_once() {
         // Spheres of 0.5 to 8 mm radius (the range of Table 3's U7 and B50 sieves), the largest
-        // reaching across the whole 5 cm box, where the search wraps around every cell once.
+        // reaching across the whole 5 cm box, where the search wraps around every cell once; at
+        // rest (every share skin/2), and at speeds up to 0.5 m/s with a 10 ms horizon and a
+        // skin of 1 mm (shares of 0.5 to 2 mm, three fifths of them clamped at either end).
         use rand::{RngExt, SeedableRng};
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
-        let skin = 2e-4;
-        for domain in [Domain::Periodic { width: 0.05 }, Domain::Cylinder { diameter: 0.05 }] {
+        let at_rest = [(2e-4, 0.0, Domain::Periodic { width: 0.05 }), (2e-4, 0.0, Domain::Cylinder { diameter: 0.05 })];
+        let moving =
+            [(1e-3, 1e-2, Domain::Periodic { width: 0.05 }), (1e-3, 1e-2, Domain::Cylinder { diameter: 0.05 })];
+        for (skin, horizon, domain) in at_rest.into_iter().chain(moving) {
             let mut b = Bodies::default();
             for _ in 0..600 {
                 let radius = 5e-4 * 16f64.powf(rng.random::<f64>().powi(3));
                 let (x, y) = (rng.random::<f64>() * 0.05, rng.random::<f64>() * 0.05);
+                let speed = if horizon > 0.0 { 0.5 * rng.random::<f64>() } else { 0.0 };
                 let body = NewBody {
                     shape: Shape::Sphere { radius },
                     position: Vector3::new(x, y, rng.random::<f64>() * 0.03),
                     orientation: UnitQuaternion::identity(),
-                    velocity: Vector3::zeros(),
+                    velocity: Vector3::new(0.0, 0.0, -speed),
                     angular_velocity: Vector3::zeros(),
                 };
                 b.push(body, 2650.0);
             }
-            let mut list = NeighbourList::new(skin);
+            let mut list = NeighbourList::new(skin, horizon);
             list.rebuild(&mut b, &domain, &mut BuildScratch::default()).unwrap();
             let listed: Vec<(u32, u32, [i16; 2])> = list.pairs.iter().map(|p| (p.i, p.j, p.image)).collect();
-            let expected = all_pairs_within_reach(&b, &domain, skin);
+            let expected = all_pairs_within_reach(&b, &domain, skin, horizon);
             assert!(expected.len() > 500, "{domain:?}: {} pairs", expected.len());
-            assert_eq!(listed, expected, "{domain:?}");
+            assert_eq!(listed, expected, "{domain:?}, horizon {horizon} s");
         }
     }
 
@@ -503,7 +558,7 @@ mod tests {
         let domain = Domain::Periodic { width: 0.05 };
         let sphere = Shape::Sphere { radius: 3e-3 };
         let mut b = bodies(&[Vector3::new(0.002, 0.02, 0.02), Vector3::new(0.0475, 0.02, 0.02)], sphere);
-        let mut list = NeighbourList::new(1e-3);
+        let mut list = NeighbourList::new(1e-3, 0.0);
         list.rebuild(&mut b, &domain, &mut BuildScratch::default()).unwrap();
         assert_eq!(list.pairs.len(), 1, "one pair, through the boundary");
         list.history[0].tangential_displacement = Vector3::new(0.0, 1e-6, 0.0);
@@ -524,7 +579,7 @@ mod tests {
         let domain = Domain::Periodic { width: 0.02 };
         let needle = Shape::Ellipsoid { semi_axes: Vector3::new(7e-3, 2e-3, 2e-3) };
         let mut b = bodies(&[Vector3::new(0.005, 0.01, 0.01), Vector3::new(0.015, 0.01, 0.01)], needle.clone());
-        let mut list = NeighbourList::new(5e-4);
+        let mut list = NeighbourList::new(5e-4, 0.0);
         list.rebuild(&mut b, &domain, &mut BuildScratch::default()).unwrap();
         let images: Vec<[i16; 2]> = list.pairs.iter().map(|p| p.image).collect();
         assert_eq!(images, vec![[-1, 0], [0, 0]]);
@@ -532,7 +587,7 @@ mod tests {
         let mut long =
             bodies(&[Vector3::new(0.01, 0.01, 0.01)], Shape::Ellipsoid { semi_axes: Vector3::new(0.0101, 2e-3, 2e-3) });
         assert!(matches!(
-            NeighbourList::new(5e-4).rebuild(&mut long, &domain, &mut BuildScratch::default()),
+            NeighbourList::new(5e-4, 0.0).rebuild(&mut long, &domain, &mut BuildScratch::default()),
             Err(SolverError::DomainTooNarrow { .. })
         ));
     }
