@@ -200,3 +200,23 @@ fn table_11_draws_the_rhine_forms_and_the_scans_study_is_the_packing_it_ran_befo
     stored["job"]["name"] = "validation-rhine-forms".into();
     assert_eq!(stored, before);
 }
+
+#[test]
+fn the_pebbles_periodic_study_is_table_11_poured_from_the_pebbles() {
+    use solver::packing::FormSpec;
+    let table11 = sedpack::campaign::read_campaign(repo("campaigns/validation-rhine-forms.yaml").as_ref()).unwrap();
+    let pebbles =
+        sedpack::campaign::read_campaign(repo("campaigns/validation-pebbles-periodic.yaml").as_ref()).unwrap();
+    assert_eq!(pebbles.jobs.len(), 3);
+    for (drawn, pebble) in table11.jobs.iter().zip(&pebbles.jobs) {
+        let library = pebble.spec.packing.grains.meshes.as_ref().unwrap();
+        assert_eq!((library.source.as_str(), library.faces), ("builtin:pebbles", 300));
+        // The pebbles carry Table 2's forms themselves, so nothing rescales them.
+        assert_eq!(pebble.spec.packing.grains.form, FormSpec::Own);
+        let mut same = drawn.spec.packing.clone();
+        same.grains.form = FormSpec::Own;
+        same.grains.meshes = pebble.spec.packing.grains.meshes.clone();
+        assert_eq!(same, pebble.spec.packing, "the two differ by the meshes alone, seed {}", same.seed);
+        assert!(analysis::paper::in_model_setting(&pebble.spec.packing), "the report compares it with Eq. 23");
+    }
+}
