@@ -202,21 +202,34 @@ fn table_11_draws_the_rhine_forms_and_the_scans_study_is_the_packing_it_ran_befo
 }
 
 #[test]
-fn the_pebbles_periodic_study_is_table_11_poured_from_the_pebbles() {
+fn the_periodic_pebble_studies_are_table_11_and_table_7s_u7_poured_from_the_pebbles() {
     use solver::packing::FormSpec;
-    let table11 = sedpack::campaign::read_campaign(repo("campaigns/validation-rhine-forms.yaml").as_ref()).unwrap();
-    let pebbles =
-        sedpack::campaign::read_campaign(repo("campaigns/validation-pebbles-periodic.yaml").as_ref()).unwrap();
-    assert_eq!(pebbles.jobs.len(), 3);
-    for (drawn, pebble) in table11.jobs.iter().zip(&pebbles.jobs) {
-        let library = pebble.spec.packing.grains.meshes.as_ref().unwrap();
-        assert_eq!((library.source.as_str(), library.faces), ("builtin:pebbles", 300));
-        // The pebbles carry Table 2's forms themselves, so nothing rescales them.
-        assert_eq!(pebble.spec.packing.grains.form, FormSpec::Own);
-        let mut same = drawn.spec.packing.clone();
-        same.grains.form = FormSpec::Own;
-        same.grains.meshes = pebble.spec.packing.grains.meshes.clone();
-        assert_eq!(same, pebble.spec.packing, "the two differ by the meshes alone, seed {}", same.seed);
-        assert!(analysis::paper::in_model_setting(&pebble.spec.packing), "the report compares it with Eq. 23");
+    let read = |file: &str| sedpack::campaign::read_campaign(repo(file).as_ref()).unwrap();
+    let table11 = read("campaigns/validation-rhine-forms.yaml");
+    let table7 = read("campaigns/validation-periodic-witness.yaml");
+    let u7 = table7.jobs.iter().filter(|j| j.spec.packing.grains.size.case().unwrap().name == "U7");
+    for (file, scans) in [
+        ("campaigns/validation-pebbles-periodic.yaml", table11.jobs.iter().collect::<Vec<_>>()),
+        ("campaigns/validation-pebbles.yaml", u7.collect()),
+    ] {
+        let pebbles = read(file);
+        assert_eq!((pebbles.jobs.len(), scans.len()), (3, 3), "{file}");
+        for (scan, pebble) in scans.iter().zip(&pebbles.jobs) {
+            let library = pebble.spec.packing.grains.meshes.as_ref().unwrap();
+            assert_eq!((library.source.as_str(), library.faces), ("builtin:pebbles", 300));
+            // The pebbles carry Table 2's forms themselves, so nothing rescales them.
+            assert_eq!(pebble.spec.packing.grains.form, FormSpec::Own);
+            let mut same = scan.spec.packing.clone();
+            same.grains.form = FormSpec::Own;
+            same.grains.meshes = pebble.spec.packing.grains.meshes.clone();
+            assert_eq!(same, pebble.spec.packing, "{file}: differs by more than the meshes, seed {}", same.seed);
+        }
     }
+    // Table 11's setting is the paper's form models' own, so the report compares it with Eq. 23.
+    assert!(
+        read("campaigns/validation-pebbles-periodic.yaml")
+            .jobs
+            .iter()
+            .all(|j| analysis::paper::in_model_setting(&j.spec.packing))
+    );
 }
