@@ -639,8 +639,8 @@ mod tests {
 
     use super::*;
 
-    /// A resting bed of spheres (2–4 mm) with a layer raining onto it at 1.5 m/s, as new grains
-    /// arrive in a packing's generation.
+    /// A bed of spheres (2–4 mm) starting at rest with a layer raining onto it at 1.5 m/s, as
+    /// new grains arrive in a packing's generation.
     fn bed_and_rain() -> Simulation {
         let material = Material { restitution: 0.1, friction: 0.5, ..Material::default() };
         let settings = Settings {
