@@ -255,12 +255,13 @@ impl NeighbourList {
         let (least, most) = (0.5 * self.skin, 2.0 * self.skin);
         self.shares.clear();
         self.shares.extend(bodies.velocity.iter().map(|v| (v.norm() * self.horizon).clamp(least, most)));
-        let grid = self.grid(bodies, domain, &mut scratch.radii)?;
+        let most = self.shares.iter().cloned().fold(0.0, f64::max);
+        let grid = self.grid(bodies, domain, most, &mut scratch.radii)?;
         scratch.bin(bodies, &self.shares, &grid);
         std::mem::swap(&mut self.pairs, &mut scratch.old_pairs);
         std::mem::swap(&mut self.history, &mut scratch.old_history);
         std::mem::swap(&mut self.cache, &mut scratch.old_cache);
-        self.list_pairs(bodies, domain, &grid, scratch);
+        self.list_pairs(bodies, domain, &grid, most, scratch);
         self.carry_over(scratch);
         self.index_by_body(bodies.len(), &mut scratch.fill);
         self.reference.clear();
@@ -282,9 +283,10 @@ impl NeighbourList {
 
     /// The cell grid for the bodies' current extent, with cells as wide as the median body's
     /// reach (twice its bounding radius plus the skin), but no more than a few cells per body.
-    fn grid(&self, bodies: &Bodies, domain: &Domain, radii: &mut Vec<f64>) -> Result<Grid, SolverError> {
+    /// `most` is the largest share of the skin.
+    fn grid(&self, bodies: &Bodies, domain: &Domain, most: f64, radii: &mut Vec<f64>) -> Result<Grid, SolverError> {
         let r_max = bodies.bounding_radius.iter().cloned().fold(0.0, f64::max);
-        let cutoff = 2.0 * (r_max + self.largest_share());
+        let cutoff = 2.0 * (r_max + most);
         // A grain must not reach its own periodic image; up to that, a pair may touch through
         // two images at once and both are listed.
         if domain.is_periodic() && cutoff >= domain.width() {
@@ -303,17 +305,13 @@ impl NeighbourList {
         Ok(Grid::new(domain, (2.0 * median + self.skin).max(sparse), z_range))
     }
 
-    /// The largest share of the skin of the last build.
-    fn largest_share(&self) -> f64 {
-        self.shares.iter().cloned().fold(0.0, f64::max)
-    }
-
     /// Every pair of pieces within reach, in the order (i, j, contact key, pieces). Each body
     /// looks for the partners no larger than itself (ties to the lower index) in the cells its
     /// reach spans, so that a few large grains do not make every small one search their range.
-    fn list_pairs(&mut self, bodies: &Bodies, domain: &Domain, grid: &Grid, s: &BuildScratch) {
+    /// `most` is the largest share of the skin.
+    fn list_pairs(&mut self, bodies: &Bodies, domain: &Domain, grid: &Grid, most: f64, s: &BuildScratch) {
         self.pairs.clear();
-        let (radius, most) = (&bodies.bounding_radius, self.largest_share());
+        let radius = &bodies.bounding_radius;
         for (i, (&xi, &ri)) in bodies.position.iter().zip(radius).enumerate() {
             let ci = grid.coordinates(&xi);
             let si = self.shares[i];
