@@ -202,6 +202,29 @@ fn table_11_draws_the_rhine_forms_and_the_scans_study_is_the_packing_it_ran_befo
 }
 
 #[test]
+fn table_11s_u7_is_table_7s_u7_with_the_rhine_forms_shaken_6_s() {
+    use solver::grain::form_distribution::RHINE_FORMS;
+    use solver::packing::FormSpec;
+    let read = |file: &str| sedpack::campaign::read_campaign(repo(file).as_ref()).unwrap();
+    let u7 = read("campaigns/validation-rhine-forms-u7.yaml");
+    let table7 = read("campaigns/validation-periodic-witness.yaml");
+    let scans: Vec<_> =
+        table7.jobs.iter().filter(|j| j.spec.packing.grains.size.case().unwrap().name == "U7").collect();
+    assert_eq!((u7.jobs.len(), scans.len()), (3, 3));
+    for (drawn, own) in u7.jobs.iter().zip(scans) {
+        let drawn = &drawn.spec.packing;
+        assert_eq!(drawn.grains.form, FormSpec::Distribution(RHINE_FORMS));
+        assert_eq!(drawn.process.shaking_duration, 6.0);
+        // The report compares it with Eq. 24 at its grains' measured forms.
+        assert!(analysis::paper::in_model_setting(drawn));
+        let mut same = drawn.clone();
+        same.grains.form = FormSpec::Own;
+        same.process.shaking_duration = own.spec.packing.process.shaking_duration;
+        assert_eq!(same, own.spec.packing, "differs by more than the forms and the shaking, seed {}", drawn.seed);
+    }
+}
+
+#[test]
 fn the_periodic_pebble_studies_are_table_11_and_table_7s_u7_poured_from_the_pebbles() {
     use solver::packing::FormSpec;
     let read = |file: &str| sedpack::campaign::read_campaign(repo(file).as_ref()).unwrap();
