@@ -230,6 +230,28 @@ fn table_11s_u7_is_table_7s_u7_with_the_rhine_forms_shaken_6_s() {
 }
 
 #[test]
+fn table_11s_u7_shaken_1_s_differs_from_table_11s_u7_by_the_shaking_and_from_table_7s_by_the_forms() {
+    use solver::packing::FormSpec;
+    let read = |file: &str| sedpack::campaign::read_campaign(repo(file).as_ref()).unwrap();
+    let short = read("campaigns/validation-rhine-forms-u7-shaken-1s.yaml");
+    let long = read("campaigns/validation-rhine-forms-u7.yaml");
+    let scans = table_7s_u7_under_the_witness();
+    assert_eq!((short.jobs.len(), long.jobs.len(), scans.len()), (3, 3, 3));
+    for ((short, long), own) in short.jobs.iter().zip(&long.jobs).zip(&scans) {
+        let short = &short.spec.packing;
+        // Table 7's own shaking, so the pair with Table 7's U7 differs by the forms alone.
+        assert_eq!(short.process.shaking_duration, own.process.shaking_duration);
+        assert_eq!(short.process.shaking_duration, 1.0);
+        let mut shaken_longer = short.clone();
+        shaken_longer.process.shaking_duration = long.spec.packing.process.shaking_duration;
+        assert_eq!(&shaken_longer, &long.spec.packing, "differs by more than the shaking, seed {}", short.seed);
+        let mut own_forms = short.clone();
+        own_forms.grains.form = FormSpec::Own;
+        assert_eq!(&own_forms, own, "differs by more than the forms, seed {}", short.seed);
+    }
+}
+
+#[test]
 fn the_periodic_pebble_studies_are_table_11_and_table_7s_u7_poured_from_the_pebbles() {
     use solver::packing::FormSpec;
     let read = |file: &str| sedpack::campaign::read_campaign(repo(file).as_ref()).unwrap();
