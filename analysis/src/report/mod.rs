@@ -254,7 +254,7 @@ fn campaign_section(
     }
     if summary.failed + summary.pending + summary.running > 0 {
         blocks.push(Block::Paragraph(format!(
-            "Only finished jobs enter the analysis ({} here); {} failed, {} are pending and {} running.",
+            "Only finished jobs enter the analysis ({} here); of the others, {} failed, {} pending and {} running.",
             records.len(),
             summary.failed,
             summary.pending,
@@ -1225,6 +1225,23 @@ mod tests {
         assert_eq!(sig(-0.000910, 3), "-0.000910");
         assert_eq!(duration(12.34), "12.3 s");
         assert_eq!(duration(3725.0), "1 h 02 min 05 s");
+    }
+
+    #[test]
+    fn the_campaign_section_counts_the_jobs_left_out_of_the_analysis_by_state() {
+        let summary = CampaignSummary {
+            name: "c".into(),
+            pending: 1,
+            running: 2,
+            done: 0,
+            failed: 3,
+            total_runtime: 0.0,
+            dropped_grains: 0,
+        };
+        let mut blocks = Vec::new();
+        campaign_section(&mut blocks, &summary, &[], None);
+        let note = "Only finished jobs enter the analysis (0 here); of the others, 3 failed, 1 pending and 2 running.";
+        assert!(blocks.iter().any(|b| matches!(b, Block::Paragraph(p) if p == note)));
     }
 
     #[test]
