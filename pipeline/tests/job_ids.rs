@@ -7,7 +7,13 @@
 mod common;
 
 use common::{fixture, repo};
+use sedpack::campaign::Campaign;
 use serde_json::Value;
+
+/// A campaign file of the repository, read as `sedpack run` reads it.
+fn read(file: &str) -> Campaign {
+    sedpack::campaign::read_campaign(repo(file).as_ref()).unwrap()
+}
 
 #[test]
 fn campaign_files_give_the_job_ids_of_version_0_1_0() {
@@ -45,7 +51,7 @@ fn campaign_files_give_the_job_ids_of_version_0_1_0() {
         ids.sort();
         ids
     };
-    let reordered = sedpack::campaign::read_campaign(repo("campaigns/validation-cylinder.yaml").as_ref()).unwrap();
+    let reordered = read("campaigns/validation-cylinder.yaml");
     let frozen = sedpack::campaign::read_campaign(&fixture("job-ids/validation-cylinder.yaml")).unwrap();
     assert_eq!(ids(&reordered.jobs), ids(&frozen.jobs));
 }
@@ -64,7 +70,7 @@ fn every_ready_campaign_file_reads_and_the_drag_study_pairs_its_seeds() {
     }
     assert!(files >= 10, "{files} campaign files");
     // With and without drag, the same eight seeds, otherwise the same jobs.
-    let drag = sedpack::campaign::read_campaign(repo("campaigns/drag.yaml").as_ref()).unwrap();
+    let drag = read("campaigns/drag.yaml");
     let seeds = |wet: bool| {
         let mut seeds: Vec<u64> =
             drag.jobs.iter().filter(|j| j.spec.packing.fluid.is_some() == wet).map(|j| j.spec.packing.seed).collect();
@@ -95,7 +101,7 @@ fn the_table_6_and_7_campaigns_are_the_papers_setups() {
         ("campaigns/validation-contact-point.yaml", "Table 6", &[("U1", 0.383), ("U7", 0.314)][..]),
         ("campaigns/validation-periodic-witness.yaml", "Table 7", &[("U7", 0.291), ("B50", 0.246)][..]),
     ] {
-        let campaign = sedpack::campaign::read_campaign(repo(file).as_ref()).unwrap();
+        let campaign = read(file);
         assert_eq!(campaign.jobs.len(), 3 * rows.len(), "{file}");
         for job in &campaign.jobs {
             let case = job.spec.packing.grains.size.case().unwrap().name;
@@ -114,8 +120,8 @@ fn the_table_6_and_7_campaigns_are_the_papers_setups() {
 
 #[test]
 fn the_shaking_study_is_table_5s_u7_and_table_6s_u7_but_for_t_s() {
-    let study = sedpack::campaign::read_campaign(repo("campaigns/validation-shaking.yaml").as_ref()).unwrap();
-    let witness = sedpack::campaign::read_campaign(repo("campaigns/validation-contact-point.yaml").as_ref()).unwrap();
+    let study = read("campaigns/validation-shaking.yaml");
+    let witness = read("campaigns/validation-contact-point.yaml");
     assert_eq!(study.jobs.len(), 9);
     for job in &study.jobs {
         let p = &job.spec.packing;
@@ -141,8 +147,8 @@ fn the_contact_point_studies_are_tables_6_and_7_with_only_the_contact_point_chan
         ("campaigns/validation-contact-point.yaml", "campaigns/validation-cylinder.yaml"),
         ("campaigns/validation-periodic-witness.yaml", "campaigns/validation-periodic.yaml"),
     ] {
-        let study = sedpack::campaign::read_campaign(repo(file).as_ref()).unwrap();
-        let reference = sedpack::campaign::read_campaign(repo(reference).as_ref()).unwrap();
+        let study = read(file);
+        let reference = read(reference);
         assert_eq!(study.jobs.len(), 6, "{file}");
         for job in &study.jobs {
             let case = job.spec.packing.grains.size.case().map(|c| c.name);
@@ -161,8 +167,7 @@ fn the_contact_point_studies_are_tables_6_and_7_with_only_the_contact_point_chan
         }
     }
     // U7's seeds come before B50's: Table 7's three seeds of U7 fit before the long B50 packings.
-    let periodic =
-        sedpack::campaign::read_campaign(repo("campaigns/validation-periodic-witness.yaml").as_ref()).unwrap();
+    let periodic = read("campaigns/validation-periodic-witness.yaml");
     let order: Vec<(&str, u64)> =
         periodic.jobs.iter().map(|j| (j.spec.packing.grains.size.case().unwrap().name, j.spec.packing.seed)).collect();
     assert_eq!(order[..4], [("U7", 1), ("U7", 2), ("U7", 3), ("B50", 1)]);
@@ -173,8 +178,8 @@ fn table_11_draws_the_rhine_forms_and_the_scans_study_is_the_packing_it_ran_befo
     use solver::dem::ContactPoint;
     use solver::grain::form_distribution::RHINE_FORMS;
     use solver::packing::FormSpec;
-    let table11 = sedpack::campaign::read_campaign(repo("campaigns/validation-rhine-forms.yaml").as_ref()).unwrap();
-    let scans = sedpack::campaign::read_campaign(repo("campaigns/validation-scans-periodic.yaml").as_ref()).unwrap();
+    let table11 = read("campaigns/validation-rhine-forms.yaml");
+    let scans = read("campaigns/validation-scans-periodic.yaml");
     assert_eq!((table11.jobs.len(), scans.jobs.len()), (3, 3));
     for (drawn, own) in table11.jobs.iter().zip(&scans.jobs) {
         assert_eq!(drawn.spec.packing.grains.form, FormSpec::Distribution(RHINE_FORMS));
@@ -204,7 +209,7 @@ fn table_11_draws_the_rhine_forms_and_the_scans_study_is_the_packing_it_ran_befo
 /// Table 7's U7 packings under the paper's contact point, seeds in order: the studies of the
 /// scans' forms and of the pebbles each change this setup in one respect.
 fn table_7s_u7_under_the_witness() -> Vec<solver::packing::PackingSpec> {
-    let table7 = sedpack::campaign::read_campaign(repo("campaigns/validation-periodic-witness.yaml").as_ref()).unwrap();
+    let table7 = read("campaigns/validation-periodic-witness.yaml");
     let u7 = table7.jobs.into_iter().filter(|j| j.spec.packing.grains.size.case().unwrap().name == "U7");
     u7.map(|j| j.spec.packing).collect()
 }
@@ -213,7 +218,7 @@ fn table_7s_u7_under_the_witness() -> Vec<solver::packing::PackingSpec> {
 fn table_11s_u7_is_table_7s_u7_with_the_rhine_forms_shaken_6_s() {
     use solver::grain::form_distribution::RHINE_FORMS;
     use solver::packing::FormSpec;
-    let u7 = sedpack::campaign::read_campaign(repo("campaigns/validation-rhine-forms-u7.yaml").as_ref()).unwrap();
+    let u7 = read("campaigns/validation-rhine-forms-u7.yaml");
     let scans = table_7s_u7_under_the_witness();
     assert_eq!((u7.jobs.len(), scans.len()), (3, 3));
     for (drawn, own) in u7.jobs.iter().zip(scans) {
@@ -232,7 +237,6 @@ fn table_11s_u7_is_table_7s_u7_with_the_rhine_forms_shaken_6_s() {
 #[test]
 fn table_11s_u7_shaken_1_s_differs_from_table_11s_u7_by_the_shaking_and_from_table_7s_by_the_forms() {
     use solver::packing::FormSpec;
-    let read = |file: &str| sedpack::campaign::read_campaign(repo(file).as_ref()).unwrap();
     let short = read("campaigns/validation-rhine-forms-u7-shaken-1s.yaml");
     let long = read("campaigns/validation-rhine-forms-u7.yaml");
     let scans = table_7s_u7_under_the_witness();
@@ -254,7 +258,6 @@ fn table_11s_u7_shaken_1_s_differs_from_table_11s_u7_by_the_shaking_and_from_tab
 #[test]
 fn the_periodic_pebble_studies_are_table_11_and_table_7s_u7_poured_from_the_pebbles() {
     use solver::packing::FormSpec;
-    let read = |file: &str| sedpack::campaign::read_campaign(repo(file).as_ref()).unwrap();
     let table11 = read("campaigns/validation-rhine-forms.yaml");
     // Table 11's setting is the paper's form models' own, so the report compares it with Eq. 23.
     for (file, scans, in_models) in [
