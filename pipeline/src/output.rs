@@ -56,3 +56,12 @@ pub fn number(x: f64) -> String {
         format!("{x:.5e}")
     }
 }
+
+/// A packing's phase in words, with the simulated time its shaking ends while it shakes
+/// ("shaking until 6.25 s"): the one phase whose end is known in advance.
+pub fn phase_words(phase: &str, shaking_until: Option<f64>) -> String {
+    match shaking_until {
+        Some(until) => format!("{phase} until {until:.2} s"),
+        None => phase.to_string(),
+    }
+}

@@ -19,6 +19,7 @@ use tokio::sync::mpsc;
 use tracing::{info, warn};
 
 use crate::meshes;
+use crate::output::phase_words;
 use crate::records::result_rows;
 use crate::spec::JobSpec;
 use crate::stored;
@@ -377,7 +378,11 @@ impl Worker {
                 Some(message) = receiver.recv() => match message {
                     Message::Progress(p) => {
                         self.bar.set_message(format!(
-                            "{label}: {} t = {:.3} s, {} grains, {} contacts", p.phase.name(), p.time, p.grains, p.contacts
+                            "{label}: {} t = {:.3} s, {} grains, {} contacts",
+                            phase_words(p.phase.name(), p.shaking_until),
+                            p.time,
+                            p.grains,
+                            p.contacts
                         ));
                     }
                     Message::Warning(text) => {
@@ -395,6 +400,7 @@ impl Worker {
                                 phase = p.phase.name(),
                                 grains = p.grains,
                                 mass_created = format!("{:.1} %", 100.0 * p.created),
+                                shaking_until = p.shaking_until,
                                 contacts = p.contacts,
                                 bytes = data.len(),
                                 "checkpoint"
@@ -509,7 +515,12 @@ pub(crate) fn simulate(
 
 /// What the store keeps of a packing's progress beside its checkpoint.
 fn stage(p: &Progress) -> Stage {
-    Stage { phase: p.phase.name().into(), grains: p.grains as u64, mass_created: p.created }
+    Stage {
+        phase: p.phase.name().into(),
+        grains: p.grains as u64,
+        mass_created: p.created,
+        shaking_until: p.shaking_until,
+    }
 }
 
 /// A checkpoint: this version's checkpoint format number followed by the packing.

@@ -143,15 +143,21 @@ fn ctrl_c_checkpoints_running_jobs_and_returns_them_to_pending() {
     assert!(simulated > 0.0, "{in_progress}");
     // The checkpoint says where the packing stood: each grain of the 0.03 kg weighs what a
     // sphere between the sieves' 5.6 and 8 mm does (ρ = 2650 kg/m³), so while the generation
-    // runs the share of the mass created lies between the grains times those two (at most 1).
+    // runs the share of the mass created lies between the grains times those two (at most 1);
+    // while the bed shakes, its 0.6 s of shaking end within 0.6 s after the checkpoint.
     let stage = &in_progress[0]["stage"];
     let (grains, created) = (stage["grains"].as_f64().unwrap(), stage["mass_created"].as_f64().unwrap());
     let share = |d: f64| 2650.0 * std::f64::consts::PI / 6.0 * d.powi(3) / 0.03;
     match stage["phase"].as_str() {
         Some("generation") => {
-            assert!((grains * share(0.0056)).min(1.0) <= created && created <= grains * share(0.008), "{stage}")
+            assert!((grains * share(0.0056)).min(1.0) <= created && created <= grains * share(0.008), "{stage}");
+            assert!(stage["shaking_until"].is_null(), "{stage}")
         }
-        Some("shaking" | "damping") => assert_eq!(created, 1.0, "{stage}"),
+        Some("shaking") => {
+            let until = stage["shaking_until"].as_f64().expect("the end of the shaking");
+            assert!(created == 1.0 && simulated < until && until <= simulated + 0.6, "{stage}")
+        }
+        Some("damping") => assert!(created == 1.0 && stage["shaking_until"].is_null(), "{stage}"),
         _ => panic!("no phase: {stage}"),
     }
     let resumed = ok(&["resume", "stop", "--db", db, "--quiet"]);

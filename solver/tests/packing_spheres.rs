@@ -58,3 +58,29 @@ fn same_seed_gives_the_same_packing_bit_for_bit_with_one_or_two_threads() {
     assert_eq!(one.velocity, two.velocity);
     assert_eq!(one.angular_velocity, two.angular_velocity);
 }
+
+#[test]
+fn the_shaking_lasts_t_s_from_the_last_set_of_grains_and_progress_says_when_it_ends() {
+    // §4.3: once the target mass is created, the bed is shaken for t_s, then damped.
+    let t_s = 0.05;
+    let mut spec = spec(0.5, t_s, 2);
+    spec.grains.mass = 0.03;
+    let dt = spec.time_step;
+    let mut packing = Packing::new(spec).unwrap();
+    let mut seen: Vec<solver::packing::Progress> = vec![packing.progress()];
+    while packing.advance(1).unwrap() != Phase::Converged {
+        seen.push(packing.progress());
+    }
+    let first = seen.iter().position(|p| p.phase == Phase::Shaking).expect("a shaking phase");
+    let last = seen.iter().rposition(|p| p.phase == Phase::Shaking).unwrap();
+    assert!(seen[..first].iter().all(|p| p.phase == Phase::Generation && p.shaking_until.is_none()));
+    assert!(seen[last + 1..].iter().all(|p| p.phase == Phase::Damping && p.shaking_until.is_none()));
+    // The phase turns before the step that follows the last set: its end is t_s after that step's start.
+    let until = seen[first].shaking_until.unwrap();
+    assert!((until - (seen[first].time - dt) - t_s).abs() < 1e-12, "{until} {:?}", seen[first]);
+    assert!(seen[first..=last].iter().all(|p| p.shaking_until == Some(until) && p.created == 1.0));
+    // Every step that starts before the end shakes; the first to start at or after it damps.
+    assert!(seen[last].time - dt < until && seen[last + 1].time - dt >= until - 1e-12, "{until} {:?}", seen[last]);
+    let steps = (last - first + 1) as f64;
+    assert!((steps - t_s / dt).abs() <= 1.0, "{steps} steps of {dt} s");
+}

@@ -429,6 +429,7 @@ impl Store {
             .bind(stage.map(|s| s.phase.as_str()))
             .bind(stage.map(|s| s.grains as i64))
             .bind(stage.map(|s| s.mass_created))
+            .bind(stage.and_then(|s| s.shaking_until))
             .execute(&mut *tx)
             .await
             .map_err(self.db())?;
@@ -468,16 +469,19 @@ impl Store {
             Option<String>,
             Option<i64>,
             Option<f64>,
+            Option<f64>,
         );
         let in_progress: Vec<ProgressRow> =
             sqlx::query_as(sql::IN_PROGRESS).bind(campaign_id).fetch_all(&mut *tx).await.map_err(self.db())?;
         tx.commit().await.map_err(self.db())?;
         let in_progress = in_progress
             .into_iter()
-            .map(|(job_id, state, worker_id, attempts, started_at, simulated_time, written_at, phase, grains, mass)| {
+            .map(|row| {
+                let (job_id, state, worker_id, attempts, started_at, simulated, written, phase, grains, mass, until) =
+                    row;
                 let stage = match (phase, grains, mass) {
                     (Some(phase), Some(grains), Some(mass_created)) => {
-                        Some(Stage { phase, grains: grains as u64, mass_created })
+                        Some(Stage { phase, grains: grains as u64, mass_created, shaking_until: until })
                     }
                     _ => None,
                 };
@@ -487,7 +491,7 @@ impl Store {
                     worker_id,
                     attempts,
                     started_at,
-                    checkpoint: simulated_time.zip(written_at),
+                    checkpoint: simulated.zip(written),
                     stage,
                 })
             })

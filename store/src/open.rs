@@ -31,6 +31,7 @@ fn migrator() -> Migrator {
         migration(3, "executor", include_str!("../migrations/0003_executor.sql")),
         migration(4, "fluid and imbrication", include_str!("../migrations/0004_fluid_and_imbrication.sql")),
         migration(5, "checkpoint stage", include_str!("../migrations/0005_checkpoint_stage.sql")),
+        migration(6, "checkpoint shaking until", include_str!("../migrations/0006_checkpoint_shaking_until.sql")),
     ])
 }
 

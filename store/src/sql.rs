@@ -90,11 +90,12 @@ pub const INSERT_GRAIN_STATISTIC: &str =
 
 // Checkpoints
 pub const UPSERT_CHECKPOINT: &str = "
-    INSERT INTO checkpoints (job_id, data, simulated_time, written_at, phase, grains, mass_created)
-    VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)
+    INSERT INTO checkpoints (job_id, data, simulated_time, written_at, phase, grains, mass_created, shaking_until)
+    VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)
     ON CONFLICT (job_id) DO UPDATE
     SET data = excluded.data, simulated_time = excluded.simulated_time, written_at = excluded.written_at,
-        phase = excluded.phase, grains = excluded.grains, mass_created = excluded.mass_created";
+        phase = excluded.phase, grains = excluded.grains, mass_created = excluded.mass_created,
+        shaking_until = excluded.shaking_until";
 pub const LOAD_CHECKPOINT: &str = "SELECT data, simulated_time, written_at FROM checkpoints WHERE job_id = ?1";
 pub const DELETE_CHECKPOINT: &str = "DELETE FROM checkpoints WHERE job_id = ?1";
 
@@ -114,7 +115,7 @@ pub const STATUS_COUNTS: &str = "
 pub const IN_PROGRESS: &str = "
     SELECT jobs.id, jobs.state, jobs.worker_id, jobs.attempts, jobs.started_at,
            checkpoints.simulated_time, checkpoints.written_at,
-           checkpoints.phase, checkpoints.grains, checkpoints.mass_created
+           checkpoints.phase, checkpoints.grains, checkpoints.mass_created, checkpoints.shaking_until
     FROM jobs LEFT JOIN checkpoints ON checkpoints.job_id = jobs.id
     WHERE jobs.campaign_id = ?1
       AND (jobs.state = 'running' OR (jobs.state = 'pending' AND checkpoints.job_id IS NOT NULL))

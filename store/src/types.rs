@@ -128,6 +128,8 @@ pub struct Stage {
     pub grains: u64,
     /// Fraction of the target mass created.
     pub mass_created: f64,
+    /// While the packing shakes, the simulated time the shaking ends.
+    pub shaking_until: Option<f64>,
 }
 
 /// A job some worker holds, for deciding whether that worker is still alive.

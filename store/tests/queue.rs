@@ -168,8 +168,10 @@ async fn status_says_how_far_running_and_interrupted_jobs_are() {
     let a = store.claim(CAMPAIGN, "w1").await.unwrap().unwrap();
     let b = store.claim(CAMPAIGN, "w2").await.unwrap().unwrap();
     let c = store.claim(CAMPAIGN, "w3").await.unwrap().unwrap();
-    let stage = Stage { phase: "generation".into(), grains: 1972, mass_created: 0.382 };
+    let stage = Stage { phase: "generation".into(), grains: 1972, mass_created: 0.382, shaking_until: None };
+    let shaking = Stage { phase: "shaking".into(), grains: 5100, mass_created: 1.0, shaking_until: Some(6.25) };
     store.save_checkpoint(&a.id, "w1", b"a", 1.5, Some(&stage)).await.unwrap();
+    store.save_checkpoint(&b.id, "w2", b"b", 5.5, Some(&shaking)).await.unwrap();
     store.save_checkpoint(&c.id, "w3", b"c", 0.5, Some(&stage)).await.unwrap();
     // A checkpoint that does not say where it stood replaces the last one's stage too.
     store.save_checkpoint(&c.id, "w3", b"c", 0.75, None).await.unwrap();
@@ -182,13 +184,13 @@ async fn status_says_how_far_running_and_interrupted_jobs_are() {
         seen,
         [
             (a.id.as_str(), JobState::Running, Some("w1"), Some(1.5)),
-            (b.id.as_str(), JobState::Running, Some("w2"), None),
+            (b.id.as_str(), JobState::Running, Some("w2"), Some(5.5)),
             (c.id.as_str(), JobState::Running, Some("w3"), Some(0.75)),
         ],
         "the fourth job, pending without a checkpoint, is not in progress"
     );
     let stages: Vec<_> = in_progress.iter().map(|p| p.stage.clone()).collect();
-    assert_eq!(stages, [Some(stage.clone()), None, None]);
+    assert_eq!(stages, [Some(stage.clone()), Some(shaking), None]);
     assert!(in_progress.iter().all(|p| p.started_at.is_some() && p.attempts == 1));
 
     // Stopped with its checkpoint, a job stays in progress as pending; a failed one leaves.

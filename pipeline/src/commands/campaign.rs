@@ -17,7 +17,7 @@ use tracing::info;
 use crate::campaign::{Campaign, read_campaign};
 use crate::cli::{CancelArgs, ContinueArgs, ExportArgs, LocalArgs, ResumeArgs, RunArgs, StatusArgs};
 use crate::executor::{Executor, Request};
-use crate::output::{Table, print_json};
+use crate::output::{Table, phase_words, print_json};
 use crate::records::new_job;
 use crate::runner::{self, OldCheckpoint, RunOptions, Summary, old_format, refuse_old_checkpoints};
 use crate::slurm::{self, Followed, RunDir, Submission, TaskRow};
@@ -468,12 +468,18 @@ fn unix_now() -> f64 {
 }
 
 /// A local job in progress in words: "running for 32 min 10 s on vm:1:0 (attempt 2); checkpoint
-/// at 1.90 s simulated (generation, 1972 grains, 38 % of the mass), 2 min 05 s ago".
+/// at 1.90 s simulated (generation, 1972 grains, 38 % of the mass), 2 min 05 s ago"; while the
+/// packing shakes, its phase says when the shaking ends ("shaking until 6.25 s").
 fn progress_text(p: &Progress, now: f64) -> String {
     let ago = |t: f64| duration((now - t).max(0.0));
     // The share of the mass created says how far the generation is, which simulated time does not.
     let stage = match &p.stage {
-        Some(s) => format!(" ({}, {} grains, {:.0} % of the mass)", s.phase, s.grains, 100.0 * s.mass_created),
+        Some(s) => format!(
+            " ({}, {} grains, {:.0} % of the mass)",
+            phase_words(&s.phase, s.shaking_until),
+            s.grains,
+            100.0 * s.mass_created
+        ),
         None => String::new(),
     };
     let checkpoint = match p.checkpoint {
@@ -582,12 +588,21 @@ mod tests {
             attempts: 2,
             started_at: Some(1000.0),
             checkpoint: Some((1.9, 2800.0)),
-            stage: Some(Stage { phase: "generation".into(), grains: 1972, mass_created: 0.382 }),
+            stage: Some(Stage { phase: "generation".into(), grains: 1972, mass_created: 0.382, shaking_until: None }),
         };
         assert_eq!(
             progress_text(&running, 2930.0),
             "running for 32 min 10 s on vm:1:0 (attempt 2); checkpoint at 1.90 s simulated \
              (generation, 1972 grains, 38 % of the mass), 2 min 10 s ago"
+        );
+        let shaking = Stage { phase: "shaking".into(), grains: 6053, mass_created: 1.0, shaking_until: Some(6.75) };
+        let shaking = Progress { checkpoint: Some((6.1234, 2800.0)), stage: Some(shaking), ..running.clone() };
+        assert!(
+            progress_text(&shaking, 2930.0).ends_with(
+                "checkpoint at 6.12 s simulated (shaking until 6.75 s, 6053 grains, 100 % of the mass), 2 min 10 s ago"
+            ),
+            "{}",
+            progress_text(&shaking, 2930.0)
         );
         let old = Progress { stage: None, ..running.clone() };
         assert!(progress_text(&old, 2930.0).ends_with("checkpoint at 1.90 s simulated, 2 min 10 s ago"));

@@ -14,7 +14,7 @@ use solver::fabric::Imbrication;
 use solver::packing::{Packing, PackingResult, Phase};
 
 use crate::cli::PackArgs;
-use crate::output::{Table, number, print_json};
+use crate::output::{Table, number, phase_words, print_json};
 use crate::spec::{JobSpec, read_job};
 use crate::vtk;
 
@@ -115,7 +115,7 @@ fn run_to_convergence(packing: &mut Packing, bar: &ProgressBar, job: &Path) -> a
         let p = packing.progress();
         bar.set_message(format!(
             "{:<10} t = {:7.3} s  grains {:6} ({:3.0} % of the mass)  contacts {:7}",
-            p.phase.name(),
+            phase_words(p.phase.name(), p.shaking_until),
             p.time,
             p.grains,
             100.0 * p.created,

@@ -140,6 +140,9 @@ pub struct TaskProgress {
     /// Fraction of the target mass created (absent from the files of sedpack before 0.2.1).
     #[serde(default)]
     pub mass_created: Option<f64>,
+    /// While the packing shakes, the simulated time the shaking ends (absent from older files).
+    #[serde(default)]
+    pub shaking_until: Option<f64>,
 }
 
 impl JobDir {
@@ -392,11 +395,19 @@ mod tests {
             grains: 900,
             contacts: 1200,
             mass_created: Some(0.4),
+            shaking_until: None,
         };
         job.write_progress(&progress).unwrap();
         assert_eq!(job.progress(), Some(progress.clone()));
         fs::write(job.progress_file(), br#"{"phase": "shaking", "time": 2.0, "grains": 10, "contacts": 3}"#).unwrap();
-        let older = TaskProgress { phase: "shaking".into(), time: 2.0, grains: 10, contacts: 3, mass_created: None };
+        let older = TaskProgress {
+            phase: "shaking".into(),
+            time: 2.0,
+            grains: 10,
+            contacts: 3,
+            mass_created: None,
+            shaking_until: None,
+        };
         assert_eq!(job.progress(), Some(older));
     }
 }

@@ -198,6 +198,7 @@ impl Observer for TaskObserver<'_> {
             grains: p.grains,
             contacts: p.contacts,
             mass_created: Some(p.created),
+            shaking_until: p.shaking_until,
         };
         // Progress is for display only: a failed write is retried next time.
         let _ = self.dir.write_progress(&progress);

@@ -12,6 +12,7 @@ use super::handle::Handle;
 use super::scheduler::TaskState;
 use super::submit::Submission;
 use super::sync::{Synced, sync};
+use crate::output::phase_words;
 
 /// How often the run directory and Slurm are looked at.
 const POLL: Duration = Duration::from_secs(3);
@@ -110,7 +111,10 @@ async fn show_tasks(
         let mass = p.mass_created.map(|m| format!(" ({:.0} % of the mass)", 100.0 * m)).unwrap_or_default();
         Some(format!(
             "task {task}, job {id}: {} t = {:.3} s, {} grains{mass}, {} contacts",
-            p.phase, p.time, p.grains, p.contacts
+            phase_words(&p.phase, p.shaking_until),
+            p.time,
+            p.grains,
+            p.contacts
         ))
     });
     for line in lines {

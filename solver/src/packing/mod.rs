@@ -89,6 +89,9 @@ pub struct Progress {
     pub contacts: usize,
     /// Fraction of the target mass created so far.
     pub created: f64,
+    /// While the packing shakes: the simulated time the shaking ends, t_s after the last set of
+    /// grains was created (§4.3).
+    pub shaking_until: Option<f64>,
 }
 
 /// One created grain as sampled: its sieve class, size D and form.
@@ -221,6 +224,7 @@ impl Packing {
             grains: self.simulation.bodies.len(),
             contacts: self.simulation.contacts,
             created: (self.created_mass / self.spec.grains.mass).min(1.0),
+            shaking_until: (self.phase == Phase::Shaking).then_some(self.shaking_until),
         }
     }
 
