@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 use solver::grain::RHINE_FORMS;
-use solver::packing::{DomainKind, FormSpec, GrainSpec, PackingSpec, ShapeKind};
+use solver::packing::{Derived, DomainKind, FormSpec, GrainSpec, PackingSpec, ShapeKind};
 
 use crate::dataset::is_single_form_statistics;
 use crate::model::{CrossValidation, LinearModel};
@@ -190,8 +190,9 @@ const SIMULATED: [Simulated; 32] = [
 /// case; meshes keeping their own forms (§5.1: any library, the paper's being its 63 Rhine
 /// scans) or, for Table 11, drawn from the Rhine distribution; no fluid forces; and every other value of the protocol and the evaluation at the paper's
 /// (`PackingSpec::paper`), the grid spacing and trim of its rules included. Only the seed, the
-/// domain height, the time limit, the meshes and the contact point of polyhedra (sedpack's
-/// centre of pressure or the paper's software's witness) may differ.
+/// domain height, the time limit, the meshes, the contact point of polyhedra (sedpack's
+/// centre of pressure or the paper's software's witness) and the calibration of k_n and d_n
+/// (sedpack's discrete one or Eq. 11 as printed) may differ.
 pub fn simulated_porosity(spec: &PackingSpec) -> Option<PaperPorosity> {
     let case = spec.grains.size.case()?.name;
     let kind = if spec.domain.is_periodic() { DomainKind::Periodic } else { DomainKind::Cylinder };
@@ -213,9 +214,18 @@ pub fn simulated_porosity(spec: &PackingSpec) -> Option<PaperPorosity> {
 
 /// Whether `spec` is the paper's protocol (`PackingSpec::paper` of its domain's kind) for meshes
 /// of `form`, of its own domain, sieve curve, mass and shaking duration, with no fluid forces;
-/// the seed, the domain height, the time limit, the meshes and the contact point of polyhedra
-/// may differ, and the grid spacing and trim are compared as the paper's rules work them out.
+/// the seed, the domain height, the time limit, the meshes, the contact point of polyhedra and
+/// the calibration may differ, and the grid spacing and trim are compared as the paper's rules
+/// work them out.
 fn follows_papers_protocol(spec: &PackingSpec, form: FormSpec) -> bool {
+    let (papers, rules) = papers_protocol(spec, form);
+    let derived = spec.derived();
+    papers == *spec && (derived.spacing, derived.trim) == (rules.spacing, rules.trim)
+}
+
+/// The paper's protocol for meshes of `form` with everything `follows_papers_protocol` lets
+/// differ taken from `spec`, and the spacing and trim its rules give.
+fn papers_protocol(spec: &PackingSpec, form: FormSpec) -> (PackingSpec, Derived) {
     let kind = if spec.domain.is_periodic() { DomainKind::Periodic } else { DomainKind::Cylinder };
     let mut papers = PackingSpec::paper(kind);
     papers.domain = spec.domain;
@@ -231,12 +241,121 @@ fn follows_papers_protocol(spec: &PackingSpec, form: FormSpec) -> bool {
     papers.height = spec.height;
     papers.seed = spec.seed;
     papers.contact_point = spec.contact_point;
+    // Eq. 11 as printed is the paper's calibration; sedpack's default is its discrete solution.
+    papers.calibration = spec.calibration;
     // A stored job names the spacing and trim that the paper's rules give (the stored form is
     // concrete): compared as worked out, not as written.
     let rules = papers.derived();
     (papers.process.spacing, papers.trim) = (spec.process.spacing, spec.trim);
+    (papers, rules)
+}
+
+/// The paper's simulated setup nearest a packing that is none of them, and what differs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NearestSetup {
+    /// "Table 7's U7 (periodic domain, L = 0.1 m, 4 kg, t_s = 1 s, meshes of their own forms)";
+    /// None when no row is near (a sieve curve not in Table 3).
+    pub setup: Option<String>,
+    /// "this setup has t_s = 6 s; it departs from the paper's protocol in process.damping".
+    pub differences: String,
+}
+
+/// Why a packing that is none of the paper's simulated setups (`simulated_porosity` gives
+/// None) is not: the nearest row of Tables 5–8 and 11 (fewest of domain, width, mass, t_s,
+/// Table 3 case and forms apart) and what differs from it, the protocol's keys included.
+pub fn nearest_papers_setup(spec: &PackingSpec) -> NearestSetup {
+    let Some(case) = spec.grains.size.case().map(|c| c.name) else {
+        let differences = "its sieve curve is none of Table 3's, the only ones the paper simulated".into();
+        return NearestSetup { setup: None, differences };
+    };
+    let kind = if spec.domain.is_periodic() { DomainKind::Periodic } else { DomainKind::Cylinder };
+    let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b.abs().max(1.0);
+    let apart = |s: &Simulated| {
+        let mut words = Vec::new();
+        if s.kind != kind {
+            words.push(format!("the {}", domain_words(kind)));
+        } else if !same(s.width, spec.domain.width()) {
+            words.push(format!("L = {} m", spec.domain.width()));
+        }
+        if !same(s.mass, spec.grains.mass) {
+            words.push(format!("{} kg", spec.grains.mass));
+        }
+        if !same(s.shaking, spec.process.shaking_duration) {
+            words.push(format!("t_s = {} s", spec.process.shaking_duration));
+        }
+        if s.case != case {
+            words.push(case.to_string());
+        }
+        if s.form != spec.grains.form {
+            words.push(form_words(spec.grains.form));
+        }
+        words
+    };
+    let row = SIMULATED.iter().min_by_key(|s| apart(s).len()).expect("the tables have rows");
+    // The forms are judged against the row above; the protocol is the rest.
+    let (papers, rules) = papers_protocol(spec, spec.grains.form);
+    let mut keys = Vec::new();
+    let to_value = |s: &PackingSpec| serde_json::to_value(s).expect("a spec is JSON");
+    differing_keys("", &to_value(&papers), &to_value(spec), &mut keys);
     let derived = spec.derived();
-    papers == *spec && (derived.spacing, derived.trim) == (rules.spacing, rules.trim)
+    if derived.spacing != rules.spacing {
+        keys.push("process.spacing".into());
+    }
+    if derived.trim != rules.trim {
+        keys.push("trim".into());
+    }
+    let mut differences = Vec::new();
+    let here = apart(row);
+    if !here.is_empty() {
+        differences.push(format!("this setup has {}", here.join(", ")));
+    }
+    if !keys.is_empty() {
+        differences.push(format!("it departs from the paper's protocol in {}", keys.join(", ")));
+    }
+    let setup = format!(
+        "{}'s {} ({}, L = {} m, {} kg, t_s = {} s, {})",
+        row.table,
+        row.case,
+        domain_words(row.kind),
+        row.width,
+        row.mass,
+        row.shaking,
+        form_words(row.form)
+    );
+    NearestSetup { setup: Some(setup), differences: differences.join("; ") }
+}
+
+fn domain_words(kind: DomainKind) -> &'static str {
+    match kind {
+        DomainKind::Periodic => "periodic domain",
+        DomainKind::Cylinder => "cylinder",
+    }
+}
+
+fn form_words(form: FormSpec) -> String {
+    match form {
+        FormSpec::Own => "meshes of their own forms".into(),
+        FormSpec::Distribution(d) if d == RHINE_FORMS => "forms drawn from the Rhine distribution".into(),
+        FormSpec::Distribution(d) => {
+            format!("forms drawn from μ_FL {}, σ_FL {}, μ_EL {}, σ_EL {}", d.mu_fl, d.sigma_fl, d.mu_el, d.sigma_el)
+        }
+        FormSpec::Single { fl, el } => format!("one form, FL {fl}, EL {el}"),
+    }
+}
+
+/// The dotted keys under which two JSON values differ.
+fn differing_keys(path: &str, a: &serde_json::Value, b: &serde_json::Value, out: &mut Vec<String>) {
+    use serde_json::Value::Object;
+    match (a, b) {
+        (Object(x), Object(y)) if x.keys().eq(y.keys()) => {
+            for (key, value) in x {
+                let inner = if path.is_empty() { key.clone() } else { format!("{path}.{key}") };
+                differing_keys(&inner, value, &y[key], out);
+            }
+        }
+        _ if a != b => out.push(path.to_string()),
+        _ => {}
+    }
 }
 
 /// The shaking duration t_s (s) of the packings the paper's porosity models were fitted to (§6.1).
@@ -364,7 +483,7 @@ mod tests {
     }
 
     #[test]
-    fn seed_height_time_limit_an_explicit_default_trim_and_the_contact_point_keep_the_setup() {
+    fn seed_height_time_limit_an_explicit_default_trim_the_contact_point_and_eq_11_keep_the_setup() {
         let mut spec = table7("U7");
         spec.seed = 7;
         spec.height = Some(0.5);
@@ -376,6 +495,9 @@ mod tests {
         assert_eq!(found(&spec).map(|f| f.1), Some(0.291));
         // The paper's software's contact point is the paper's setup too.
         spec.contact_point = solver::dem::ContactPoint::Witness;
+        assert_eq!(found(&spec).map(|f| f.1), Some(0.291));
+        // So is Eq. 11 as the paper prints it, which its software uses.
+        spec.calibration = solver::dem::Calibration::Continuous;
         assert_eq!(found(&spec).map(|f| f.1), Some(0.291));
     }
 
@@ -410,6 +532,42 @@ mod tests {
             change(&mut spec);
             assert_eq!(found(&spec), None, "{what}");
         }
+    }
+
+    #[test]
+    fn a_setup_that_is_none_of_the_papers_is_told_the_nearest_and_what_differs() {
+        let told = |change: fn(&mut PackingSpec)| {
+            let mut spec = table7("U7");
+            change(&mut spec);
+            assert_eq!(found(&spec), None);
+            let nearest = nearest_papers_setup(&spec);
+            (nearest.setup.unwrap_or_default(), nearest.differences)
+        };
+        let row = "Table 7's U7 (periodic domain, L = 0.1 m, 4 kg, t_s = 1 s, meshes of their own forms)";
+        // Table 11's U7 forms in Table 7's setup: one apart from Table 7's row, three from Table 11's.
+        let drawn = told(|s| s.grains.form = FormSpec::Distribution(RHINE_FORMS));
+        assert_eq!(drawn, (row.into(), "this setup has forms drawn from the Rhine distribution".into()));
+        let ellipsoids = told(|s| s.grains.shape = ShapeKind::Ellipsoid);
+        assert_eq!(ellipsoids, (row.into(), "it departs from the paper's protocol in grains.shape".into()));
+        let both = told(|s| (s.process.shaking_duration, s.process.damping) = (2.0, 1e-2));
+        let differences = "this setup has t_s = 2 s; it departs from the paper's protocol in process.damping";
+        assert_eq!(both, (row.into(), differences.into()));
+        let spacing = told(|s| s.process.spacing = Some(0.03));
+        assert_eq!(spacing.1, "it departs from the paper's protocol in process.spacing");
+        // Scaled down, Table 11's U1 is nearest the default periodic U1 of Table 11's scans.
+        let mut scaled = table11();
+        scaled.grains.size = TABLE3[0].sieve_curve();
+        let nearest = nearest_papers_setup(&scaled);
+        assert_eq!(
+            nearest.setup.as_deref(),
+            Some(
+                "Table 11's U1 (periodic domain, L = 0.2 m, 16 kg, t_s = 6 s, forms drawn from the Rhine distribution)"
+            )
+        );
+        assert_eq!(nearest.differences, "this setup has L = 0.06 m, 1.44 kg");
+        let mut custom = table7("U7");
+        custom.grains.size = solver::grain::SieveCurve::new(vec![0.01, 0.02], vec![1.0]).unwrap();
+        assert_eq!(nearest_papers_setup(&custom).setup, None);
     }
 
     /// The paper's periodic setting of its models (t_s = 6 s) with meshes of the Rhine form

@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use solver::fabric::Imbrication;
 use solver::porosity::ProfilePoint;
 
-use crate::paper::{ModelPorosity, PaperPorosity};
+use crate::paper::{ModelPorosity, NearestSetup, PaperPorosity};
 
 /// A measured porosity to compare the simulated one with (Table 6).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -35,6 +35,9 @@ pub struct JobRecord {
     pub experiment: Option<Experiment>,
     /// The paper's simulated porosity, when the packing is one of its setups (Tables 5–8, 11).
     pub paper: Option<PaperPorosity>,
+    /// When it is none of them: the nearest of the paper's setups and what differs.
+    #[serde(default)]
+    pub paper_nearest: Option<NearestSetup>,
     /// The paper's porosity model at the grains' measured forms, when the packing is in the
     /// models' setting (Eqs. 17–19, 23–24).
     #[serde(default)]

@@ -17,6 +17,7 @@ fn record(id: &str, porosity: f64, grains: &[(f64, f64)]) -> JobRecord {
         size_case: None,
         experiment: None,
         paper: None,
+        paper_nearest: None,
         paper_model: None,
         fluid: None,
         imbrication: None,

@@ -8,7 +8,7 @@ use analysis::analyse;
 use analysis::dataset::mixture_feature_names;
 use analysis::form_factors::{form_feature_names, grain_statistics};
 use analysis::model::LinearModel;
-use analysis::paper::{ModelPorosity, PaperPorosity};
+use analysis::paper::{ModelPorosity, NearestSetup, PaperPorosity};
 use analysis::record::{CampaignSummary, Cost, Experiment, JobRecord};
 use analysis::report::{ReportFiles, write_report};
 use analysis::selection::SelectionOptions;
@@ -74,6 +74,7 @@ fn mixture_campaign() -> Vec<JobRecord> {
                         size_case: None,
                         experiment: None,
                         paper: None,
+                        paper_nearest: None,
                         paper_model: None,
                         fluid: None,
                         imbrication: None,
@@ -256,6 +257,7 @@ fn validation_campaign() -> Vec<JobRecord> {
                 size_case: None,
                 experiment: Some(experiment),
                 paper: None,
+                paper_nearest: None,
                 paper_model: None,
                 fluid: None,
                 imbrication: None,
@@ -359,6 +361,36 @@ fn packings_of_the_papers_setups_are_compared_with_its_simulations() {
 }
 
 #[test]
+fn setups_that_are_none_of_the_papers_are_told_the_nearest_and_what_differs() {
+    let nearest = NearestSetup {
+        setup: Some("Table 7's U7 (periodic domain, L = 0.1 m, 4 kg, t_s = 1 s, meshes of their own forms)".into()),
+        differences: "this setup has forms drawn from the Rhine distribution".into(),
+    };
+    let row = "| grains.size = U3 | Table 7's U7 (periodic domain, L = 0.1 m, 4 kg, t_s = 1 s, meshes of their own forms) | this setup has forms drawn from the Rhine distribution |";
+    let mut records: Vec<JobRecord> = validation_campaign();
+    for r in records.iter_mut().filter(|r| r.job_id.starts_with("U3")) {
+        r.paper_nearest = Some(nearest.clone());
+    }
+    let out = tempfile::tempdir().unwrap();
+    // U1 is the paper's setup: compared; U3 is not, and is told why after the comparison.
+    for r in records.iter_mut().filter(|r| r.job_id.starts_with("U1")) {
+        r.paper = Some(PaperPorosity { table: "Table 6".into(), porosity: 0.383, std: Some(0.002) });
+    }
+    let md = std::fs::read_to_string(report("validation", &records, out.path()).markdown).unwrap();
+    let section = &md[md.find("## Comparison with the paper's simulations").expect(&md)..];
+    let other = section.find("The other setups are none of the paper's simulated setups").expect(section);
+    assert!(section[..other].contains("| grains.size = U1 |"), "{section}");
+    assert!(section[other..].contains(row), "{section}");
+    assert!(!section[other..].contains("| grains.size = U1 |"), "{section}");
+    // No setup of the paper's: the section still comes, to say so.
+    let records: Vec<JobRecord> = records.into_iter().filter(|r| r.job_id.starts_with("U3")).collect();
+    let md = std::fs::read_to_string(report("validation", &records, out.path()).markdown).unwrap();
+    let section = &md[md.find("## Comparison with the paper's simulations").expect(&md)..];
+    assert!(section.contains("No setup of this campaign is one of the paper's simulated setups"), "{section}");
+    assert!(section.contains(row), "{section}");
+}
+
+#[test]
 fn packings_in_the_models_setting_are_compared_with_the_papers_model() {
     // Two runs of a form mixture (Eq. 23 at each run's measured forms: 0.356 and 0.358) and one
     // of the two scans' own forms, whose σ_EL lies far below the paper's.
@@ -459,6 +491,7 @@ fn shape_records(size_case: Option<&str>) -> Vec<JobRecord> {
                 size_case: size_case.map(String::from),
                 experiment: None,
                 paper: None,
+                paper_nearest: None,
                 paper_model: None,
                 fluid: None,
                 imbrication: None,
@@ -560,6 +593,7 @@ fn a_campaign_with_and_without_drag_compares_them_seed_by_seed() {
                 size_case: None,
                 experiment: None,
                 paper: None,
+                paper_nearest: None,
                 paper_model: None,
                 fluid: fluid.map(String::from),
                 imbrication: None,
@@ -617,6 +651,7 @@ fn the_imbrication_of_each_setup_is_summed_over_its_runs() {
                 size_case: None,
                 experiment: None,
                 paper: None,
+                paper_nearest: None,
                 paper_model: None,
                 fluid: Some(fluid.into()),
                 imbrication: Some(f),

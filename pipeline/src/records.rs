@@ -4,7 +4,7 @@
 
 use std::collections::BTreeMap;
 
-use analysis::paper::{model_porosity, simulated_porosity};
+use analysis::paper::{model_porosity, nearest_papers_setup, simulated_porosity};
 use analysis::record::Cost;
 use analysis::{CampaignSummary, Experiment, JobRecord};
 use anyhow::Context;
@@ -213,6 +213,7 @@ pub fn job_record(row: &ExportRow, spec: Option<&PackingSpec>) -> anyhow::Result
         size_case: spec.and_then(|s| s.grains.size.case()).map(|c| c.name.to_string()),
         experiment: row.experiment_porosity.map(|porosity| Experiment { porosity, std: row.experiment_std }),
         paper: spec.and_then(simulated_porosity),
+        paper_nearest: spec.filter(|s| simulated_porosity(s).is_none()).map(nearest_papers_setup),
         paper_model: spec.and_then(|s| model_porosity(s, &grain_statistics)),
         grain_statistics,
         fluid: fluid.map(|f| f.describe()),

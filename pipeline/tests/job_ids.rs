@@ -174,6 +174,30 @@ fn the_contact_point_studies_are_tables_6_and_7_with_only_the_contact_point_chan
 }
 
 #[test]
+fn the_calibration_study_is_the_contact_points_u1_with_eq_11_as_printed() {
+    use solver::dem::Calibration;
+    let study = read("campaigns/validation-calibration.yaml");
+    let witness = read("campaigns/validation-contact-point.yaml");
+    assert_eq!(study.jobs.len(), 3);
+    for job in &study.jobs {
+        let eq11 = &job.spec.packing;
+        assert_eq!(eq11.calibration, Calibration::Continuous);
+        // Eq. 11 as printed is the paper's own: the report compares the study with Table 6.
+        let paper = analysis::paper::simulated_porosity(eq11).unwrap();
+        assert_eq!((paper.table.as_str(), paper.porosity), ("Table 6", 0.383));
+        let reference = witness
+            .jobs
+            .iter()
+            .map(|j| &j.spec.packing)
+            .find(|p| p.seed == eq11.seed && p.grains.size.case().map(|c| c.name) == Some("U1"))
+            .unwrap();
+        let mut same = eq11.clone();
+        same.calibration = Calibration::Discrete;
+        assert_eq!(&same, reference, "seed {}", eq11.seed);
+    }
+}
+
+#[test]
 fn table_11_draws_the_rhine_forms_and_the_scans_study_is_the_packing_it_ran_before() {
     use solver::dem::ContactPoint;
     use solver::grain::form_distribution::RHINE_FORMS;

@@ -398,11 +398,13 @@ fn experiment_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
 }
 
 /// Tables 5–8 and 11: the runs of each setup the paper simulated against the paper's runs.
+/// Setups that are none of them follow, each with the nearest of the paper's and what differs.
 fn paper_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
+    let compared = records.iter().any(|r| r.paper.is_some());
     comparison(
         blocks,
         "Comparison with the paper's simulations",
-        "Like Tables 5–8 and 11: the runs of each setup that is one of the paper's simulated setups (the table's domain, width, mass, shaking duration t_s and Table 3 case, meshes keeping their own forms or, for Table 11, drawn from the Rhine distribution, no fluid forces, and the paper's protocol and evaluation otherwise; seed, domain height, time limit, meshes and the contact point of polyhedra may differ), their mean and standard deviation, the paper's porosity for the setup (the mean of its three runs ± their standard deviation, where the table gives one) and the difference sedpack − paper. The paper drew its grains from 63 scanned Rhine grains; a library of fewer meshes samples fewer shapes.",
+        "Like Tables 5–8 and 11: the runs of each setup that is one of the paper's simulated setups (the table's domain, width, mass, shaking duration t_s and Table 3 case, meshes keeping their own forms or, for Table 11, drawn from the Rhine distribution, no fluid forces, and the paper's protocol and evaluation otherwise; seed, domain height, time limit, meshes, the contact point of polyhedra and the calibration of Eq. 11 may differ), their mean and standard deviation, the paper's porosity for the setup (the mean of its three runs ± their standard deviation, where the table gives one) and the difference sedpack − paper. The paper drew its grains from 63 scanned Rhine grains; a library of fewer meshes samples fewer shapes.",
         ["sedpack n (mean ± std)", "paper n (mean ± std)", "source", "difference"],
         &grouped(records, |r| Some((setup_label(r), r.paper.clone()?))),
         |mean, paper| {
@@ -413,6 +415,27 @@ fn paper_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
             (paper.porosity, vec![shown, paper.table.clone(), format!("{:.3}", mean - paper.porosity)])
         },
     );
+    let others = grouped(records, |r| Some((setup_label(r), r.paper_nearest.clone()?)));
+    if others.is_empty() {
+        return;
+    }
+    let intro = if compared {
+        "The other setups are none of the paper's simulated setups; the nearest of those to each, and what differs:"
+    } else {
+        blocks.push(Block::Heading("Comparison with the paper's simulations".into()));
+        "No setup of this campaign is one of the paper's simulated setups (Tables 5–8 and 11, each by the paper's protocol: see the README's \"sedpack report\"), so there is nothing of the paper's to set its porosity beside. The nearest of the paper's setups to each, and what differs:"
+    };
+    blocks.push(Block::Paragraph(intro.into()));
+    let rows = others
+        .iter()
+        .map(|((label, nearest), _)| {
+            vec![label.clone(), nearest.setup.clone().unwrap_or_else(|| "none".into()), nearest.differences.clone()]
+        })
+        .collect();
+    blocks.push(Block::Table {
+        header: ["setup", "nearest of the paper's setups", "what differs"].map(String::from).to_vec(),
+        rows,
+    });
 }
 
 /// Eqs. 17–19 and 23–24: the runs of each setup in the setting of the paper's porosity models
@@ -1255,6 +1278,7 @@ mod tests {
             size_case: None,
             experiment: None,
             paper: None,
+            paper_nearest: None,
             paper_model: None,
             fluid: None,
             imbrication: None,
