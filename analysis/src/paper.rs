@@ -191,8 +191,9 @@ const SIMULATED: [Simulated; 32] = [
 /// scans) or, for Table 11, drawn from the Rhine distribution; no fluid forces; and every other value of the protocol and the evaluation at the paper's
 /// (`PackingSpec::paper`), the grid spacing and trim of its rules included. Only the seed, the
 /// domain height, the time limit, the meshes, the contact point of polyhedra (sedpack's
-/// centre of pressure or the paper's software's witness) and the calibration of k_n and d_n
-/// (sedpack's discrete one or Eq. 11 as printed) may differ.
+/// centre of pressure or the paper's software's witness), the calibration of k_n and d_n
+/// (sedpack's discrete one or Eq. 11 as printed) and the orientation of new grains (sedpack's
+/// random turns or the paper's software's upright grains) may differ.
 pub fn simulated_porosity(spec: &PackingSpec) -> Option<PaperPorosity> {
     let case = spec.grains.size.case()?.name;
     let kind = if spec.domain.is_periodic() { DomainKind::Periodic } else { DomainKind::Cylinder };
@@ -214,8 +215,8 @@ pub fn simulated_porosity(spec: &PackingSpec) -> Option<PaperPorosity> {
 
 /// Whether `spec` is the paper's protocol (`PackingSpec::paper` of its domain's kind) for meshes
 /// of `form`, of its own domain, sieve curve, mass and shaking duration, with no fluid forces;
-/// the seed, the domain height, the time limit, the meshes, the contact point of polyhedra and
-/// the calibration may differ, and the grid spacing and trim are compared as the paper's rules
+/// the seed, the domain height, the time limit, the meshes, the contact point of polyhedra, the
+/// calibration and the orientation of new grains may differ, and the grid spacing and trim are compared as the paper's rules
 /// work them out.
 fn follows_papers_protocol(spec: &PackingSpec, form: FormSpec) -> bool {
     let (papers, rules) = papers_protocol(spec, form);
@@ -243,6 +244,8 @@ fn papers_protocol(spec: &PackingSpec, form: FormSpec) -> (PackingSpec, Derived)
     papers.contact_point = spec.contact_point;
     // Eq. 11 as printed is the paper's calibration; sedpack's default is its discrete solution.
     papers.calibration = spec.calibration;
+    // §4.3 does not say how new grains lie; its software creates them upright.
+    papers.process.orientation = spec.process.orientation;
     // A stored job names the spacing and trim that the paper's rules give (the stored form is
     // concrete): compared as worked out, not as written.
     let rules = papers.derived();
@@ -483,7 +486,7 @@ mod tests {
     }
 
     #[test]
-    fn seed_height_time_limit_an_explicit_default_trim_the_contact_point_and_eq_11_keep_the_setup() {
+    fn seed_height_time_limit_explicit_defaults_and_the_papers_software_keep_the_setup() {
         let mut spec = table7("U7");
         spec.seed = 7;
         spec.height = Some(0.5);
@@ -496,8 +499,11 @@ mod tests {
         // The paper's software's contact point is the paper's setup too.
         spec.contact_point = solver::dem::ContactPoint::Witness;
         assert_eq!(found(&spec).map(|f| f.1), Some(0.291));
-        // So is Eq. 11 as the paper prints it, which its software uses.
+        // So is Eq. 11 as the paper prints it, which its software uses, and its software's
+        // upright new grains.
         spec.calibration = solver::dem::Calibration::Continuous;
+        assert_eq!(found(&spec).map(|f| f.1), Some(0.291));
+        spec.process.orientation = solver::packing::Orientation::Upright;
         assert_eq!(found(&spec).map(|f| f.1), Some(0.291));
     }
 

@@ -170,6 +170,17 @@ pub struct FlowFile {
 pub struct GenerationFile {
     pub spacing: Option<Auto>,
     pub velocity: Option<f64>,
+    pub orientation: Option<OrientationFile>,
+}
+
+/// How a new grain lies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum OrientationFile {
+    /// Turned uniformly at random (default).
+    Random,
+    /// Long axis vertical, short axis along x, every grain alike: the paper's software.
+    Upright,
 }
 
 #[derive(Debug, Default, Deserialize)]

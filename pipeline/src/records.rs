@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 use solver::dem::{ContactPoint, Domain};
 use solver::fabric::Imbrication;
 use solver::fluid::flow::Flow;
-use solver::packing::{FormSpec, PackingResult, PackingSpec, ShapeKind};
+use solver::packing::{FormSpec, Orientation, PackingResult, PackingSpec, ShapeKind};
 use solver::porosity::ProfilePoint;
 use store::{CampaignStatus, ExportRow, GrainStatistic, JobResult, NewJob};
 
@@ -153,6 +153,9 @@ fn setup(spec: &PackingSpec) -> Vec<(String, String)> {
             ContactPoint::Witness => "EPA's witness midpoint (the paper's software)",
         };
         items.push(("contact point", rule.to_string()));
+    }
+    if spec.process.orientation == Orientation::Upright {
+        items.push(("new grains", "upright, long axis vertical (the paper's software)".to_string()));
     }
     items.push((
         "fluid forces",

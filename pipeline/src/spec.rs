@@ -10,12 +10,14 @@ use solver::dem::{Calibration, ContactPoint, Domain, Material};
 use solver::fluid::flow::Flow;
 use solver::grain::simplify::DEFAULT_MAX_FACES;
 use solver::grain::{FormDistribution, SieveCurve, Table3Case};
-use solver::packing::{DomainKind, FluidSpec, FormSpec, PackingSpec, Process, ShapeKind, SpecError, in_range};
+use solver::packing::{
+    DomainKind, FluidSpec, FormSpec, Orientation, PackingSpec, Process, ShapeKind, SpecError, in_range,
+};
 
 use crate::job_file::{
     CalibrationFile, ContactPointFile, DomainFile, DomainKindFile, EvaluationFile, ExperimentFile, FlowFile,
-    FlowKindFile, FluidFile, FormFile, GrainsFile, JobFile, MaterialFile, ProcessFile, ProcessFluidFile, ShapeFile,
-    SizeFile, SolverFile, Source, read_job_file,
+    FlowKindFile, FluidFile, FormFile, GrainsFile, JobFile, MaterialFile, OrientationFile, ProcessFile,
+    ProcessFluidFile, ShapeFile, SizeFile, SolverFile, Source, read_job_file,
 };
 use crate::meshes;
 
@@ -184,6 +186,13 @@ fn process(p: ProcessFile, process: &mut Process) {
     let generation = p.generation.unwrap_or_default();
     process.spacing = generation.spacing.and_then(|h| h.given());
     set(&mut process.velocity, generation.velocity);
+    set(
+        &mut process.orientation,
+        generation.orientation.map(|o| match o {
+            OrientationFile::Random => Orientation::Random,
+            OrientationFile::Upright => Orientation::Upright,
+        }),
+    );
     let shaking = p.shaking.unwrap_or_default();
     set(&mut process.shaking.amplitude, shaking.amplitude);
     set(&mut process.shaking.period, shaking.period);

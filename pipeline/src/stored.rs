@@ -18,6 +18,10 @@
 //!   witness (`packing.contact_point`, the rule of the paper's software), which formats 1 to 3
 //!   have not: a job with the centre of pressure is written as before, and a version that knows
 //!   only formats 1 to 3 refuses a job with the witness instead of running it with the centre.
+//! - Format 5 is format 2, 3 or 4 whose identity creates every grain upright
+//!   (`packing.process.orientation`, as the paper's software does), which formats 1 to 4 have
+//!   not: a job of randomly turned grains is written as before, and a version that knows only
+//!   formats 1 to 4 refuses a job of upright grains instead of turning them at random.
 //!
 //! A stored format is frozen: a release that adds a field writes a new format with its own types
 //! beside these, keeps reading every older one (giving the new field the value that reproduces
@@ -29,25 +33,28 @@ use sha2::{Digest, Sha256};
 use solver::dem::{Calibration, ContactPoint, Domain, Material, Shaking};
 use solver::fluid::flow::Flow;
 use solver::grain::{FormDistribution, MeshLibrary, SieveCurve, Table3Case};
-use solver::packing::{FluidSpec, FormSpec, GrainSpec, PackingSpec, Process, ShapeKind};
+use solver::packing::{FluidSpec, FormSpec, GrainSpec, Orientation, PackingSpec, Process, ShapeKind};
 
 use crate::meshes;
 use crate::spec::JobSpec;
 
 /// The newest format this version reads and writes.
-pub const FORMAT: u32 = 4;
+pub const FORMAT: u32 = 5;
 
 /// The format a job is written in: the oldest of this version's that holds it.
 pub fn format(job: &JobSpec) -> u32 {
-    needed(job.packing.contact_point == ContactPoint::Witness, job.packing.fluid.is_some())
+    let p = &job.packing;
+    needed(p.process.orientation == Orientation::Upright, p.contact_point == ContactPoint::Witness, p.fluid.is_some())
 }
 
-/// The oldest format with a witness contact point and fluid forces if these are present.
-fn needed(witness: bool, fluid: bool) -> u32 {
-    match (witness, fluid) {
-        (true, _) => 4,
-        (false, true) => 3,
-        (false, false) => 2,
+/// The oldest format with upright grains, a witness contact point and fluid forces if these
+/// are present.
+fn needed(upright: bool, witness: bool, fluid: bool) -> u32 {
+    match (upright, witness, fluid) {
+        (true, ..) => 5,
+        (false, true, _) => 4,
+        (false, false, true) => 3,
+        (false, false, false) => 2,
     }
 }
 /// A mesh folder's name in a format 2 identity.
@@ -194,6 +201,16 @@ mod v1 {
         pub(super) height_change: f64,
         pub(super) interval: f64,
         pub(super) max_time: f64,
+        /// Format 5 only; absent (turned at random), it leaves the bytes of formats 1 to 4 as
+        /// they were.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub(super) orientation: Option<Orientation>,
+    }
+
+    /// An orientation of new grains other than random, the only one formats 1 to 4 know.
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    pub(super) enum Orientation {
+        Upright,
     }
 
     #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -209,7 +226,7 @@ mod v1 {
     }
 }
 
-/// Formats 2 to 4: format 1's job with the place of its mesh folder taken out of it.
+/// Formats 2 to 5: format 1's job with the place of its mesh folder taken out of it.
 mod v2 {
     use serde::{Deserialize, Serialize};
 
@@ -247,7 +264,7 @@ pub fn job_id(job: &JobSpec) -> String {
 pub fn decode(format: u32, json: &serde_json::Value) -> anyhow::Result<JobSpec> {
     let job = match format {
         1 => serde_json::from_value(json.clone()).context("the stored job is not format 1")?,
-        2..=4 => {
+        2..=5 => {
             let v2::Job { mut job, mesh_folder } = serde_json::from_value(json.clone())
                 .with_context(|| format!("the stored job is not format {format}"))?;
             let named = job.packing.grains.meshes.as_mut().map(|m| &mut m.source);
@@ -267,11 +284,12 @@ pub fn decode(format: u32, json: &serde_json::Value) -> anyhow::Result<JobSpec> 
              cannot read: a newer sedpack stored it"
         ),
     };
-    let wanted = needed(job.packing.contact_point.is_some(), job.packing.fluid.is_some());
+    let p = &job.packing;
+    let wanted = needed(p.process.orientation.is_some(), p.contact_point.is_some(), p.fluid.is_some());
     if wanted != format && !(format == 1 && wanted == 2) {
         bail!(
             "the stored job is not format {format}: format 3 is the one with fluid forces, format 4 the one \
-             with EPA's witness as the contact point of polyhedra"
+             with EPA's witness as the contact point of polyhedra, format 5 the one with upright grains"
         );
     }
     from_v1(job)
@@ -347,6 +365,10 @@ fn from_v1(job: v1::Job) -> anyhow::Result<JobSpec> {
         process: Process {
             spacing: Some(p.process.spacing),
             velocity: p.process.velocity,
+            orientation: match p.process.orientation {
+                None => Orientation::Random,
+                Some(v1::Orientation::Upright) => Orientation::Upright,
+            },
             shaking: Shaking { amplitude: p.process.shaking.amplitude, period: p.process.shaking.period },
             shaking_duration: p.process.shaking_duration,
             damping: p.process.damping,
@@ -440,6 +462,10 @@ fn identity(job: &JobSpec) -> v1::Job {
                 height_change: p.height_change,
                 interval: p.interval,
                 max_time: derived.max_time,
+                orientation: match p.orientation {
+                    Orientation::Random => None,
+                    Orientation::Upright => Some(v1::Orientation::Upright),
+                },
             },
             slice: spec.slice,
             cutoff: spec.cutoff,
@@ -599,10 +625,39 @@ mod tests {
     }
 
     #[test]
+    fn a_job_of_upright_grains_is_format_5_and_random_turns_keep_their_id() {
+        let mut spec = PackingSpec::paper(DomainKind::Cylinder);
+        spec.process.orientation = Orientation::Upright;
+        let original = job(spec);
+        assert_eq!(format(&original), 5);
+        let stored = encode(&original);
+        assert_eq!(stored["job"]["packing"]["process"]["orientation"], "Upright");
+        let back = decode(5, &stored).unwrap();
+        assert_eq!(back.packing.process.orientation, Orientation::Upright);
+        assert_eq!(canonical_json(&back), canonical_json(&original));
+        let random = job(PackingSpec::paper(DomainKind::Cylinder));
+        assert_ne!(job_id(&original), job_id(&random));
+        // Random turns are what formats 1 to 4 mean: no key, the same bytes and id.
+        assert!(encode(&random)["job"]["packing"]["process"].get("orientation").is_none());
+        assert_eq!(format(&random), 2);
+        // With the witness too it is format 5; a version reading it as format 4 refuses it.
+        let mut both = original.clone();
+        both.packing.contact_point = ContactPoint::Witness;
+        assert_eq!(format(&both), 5);
+        assert_eq!(decode(5, &encode(&both)).unwrap().packing.contact_point, ContactPoint::Witness);
+        for older in [2, 4] {
+            let error = decode(older, &stored).unwrap_err().to_string();
+            assert!(error.contains("format 5 the one with upright grains"), "{error}");
+        }
+        let error = decode(5, &encode(&random)).unwrap_err().to_string();
+        assert!(error.contains("not format 5"), "{error}");
+    }
+
+    #[test]
     fn stored_jobs_that_disagree_with_themselves_or_another_format_are_refused() {
         let stored = encode(&job(PackingSpec::paper(DomainKind::Periodic)));
-        let error = decode(5, &stored).unwrap_err().to_string();
-        assert!(error.contains("format 5") && error.contains("formats 1 to 4"), "{error}");
+        let error = decode(6, &stored).unwrap_err().to_string();
+        assert!(error.contains("format 6") && error.contains("formats 1 to 5"), "{error}");
         let error = format!("{:#}", decode(1, &stored).unwrap_err());
         assert!(error.contains("not format 1"), "{error}");
         let error = decode(3, &stored).unwrap_err().to_string();

@@ -96,6 +96,8 @@ fn bad_job_files_name_the_file_line_and_key() {
     fails(&["pack", &wrong], &["wrong.yaml:1", "seed"]);
     let point = write(dir.path(), "point.yaml", "solver:\n  contact_point: epa\n");
     fails(&["pack", &point], &["point.yaml:2", "contact_point", "centre-of-pressure", "witness"]);
+    let lying = write(dir.path(), "lying.yaml", "process:\n  generation:\n    orientation: flat\n");
+    fails(&["pack", &lying], &["lying.yaml:3", "orientation", "random", "upright"]);
     let step = write(dir.path(), "step.yaml", "solver: {time_step: 1.0e-4}\n");
     fails(&["pack", &step], &["step.yaml:1", "solver.time_step", "collision_time / 10"]);
     let case = write(dir.path(), "case.yaml", "grains: {size: U4}\n");

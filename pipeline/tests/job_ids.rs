@@ -174,26 +174,38 @@ fn the_contact_point_studies_are_tables_6_and_7_with_only_the_contact_point_chan
 }
 
 #[test]
-fn the_calibration_study_is_the_contact_points_u1_with_eq_11_as_printed() {
+fn the_calibration_and_orientation_studies_are_the_contact_points_u1_with_one_change() {
     use solver::dem::Calibration;
-    let study = read("campaigns/validation-calibration.yaml");
+    use solver::packing::{Orientation, PackingSpec};
     let witness = read("campaigns/validation-contact-point.yaml");
-    assert_eq!(study.jobs.len(), 3);
-    for job in &study.jobs {
-        let eq11 = &job.spec.packing;
-        assert_eq!(eq11.calibration, Calibration::Continuous);
-        // Eq. 11 as printed is the paper's own: the report compares the study with Table 6.
-        let paper = analysis::paper::simulated_porosity(eq11).unwrap();
-        assert_eq!((paper.table.as_str(), paper.porosity), ("Table 6", 0.383));
-        let reference = witness
-            .jobs
-            .iter()
-            .map(|j| &j.spec.packing)
-            .find(|p| p.seed == eq11.seed && p.grains.size.case().map(|c| c.name) == Some("U1"))
-            .unwrap();
-        let mut same = eq11.clone();
-        same.calibration = Calibration::Discrete;
-        assert_eq!(&same, reference, "seed {}", eq11.seed);
+    type Undo = fn(&mut PackingSpec) -> bool;
+    let studies: [(&str, Undo); 2] = [
+        ("campaigns/validation-calibration.yaml", |p| {
+            std::mem::replace(&mut p.calibration, Calibration::Discrete) == Calibration::Continuous
+        }),
+        ("campaigns/validation-orientation.yaml", |p| {
+            std::mem::replace(&mut p.process.orientation, Orientation::Random) == Orientation::Upright
+        }),
+    ];
+    for (file, undo) in studies {
+        let study = read(file);
+        assert_eq!(study.jobs.len(), 3, "{file}");
+        for job in &study.jobs {
+            let changed = &job.spec.packing;
+            // Eq. 11 as printed and upright new grains are the paper's and its software's own:
+            // the report compares the studies with Table 6.
+            let paper = analysis::paper::simulated_porosity(changed).unwrap();
+            assert_eq!((paper.table.as_str(), paper.porosity), ("Table 6", 0.383), "{file}");
+            let reference = witness
+                .jobs
+                .iter()
+                .map(|j| &j.spec.packing)
+                .find(|p| p.seed == changed.seed && p.grains.size.case().map(|c| c.name) == Some("U1"))
+                .unwrap();
+            let mut same = changed.clone();
+            assert!(undo(&mut same), "{file}: the study's change");
+            assert_eq!(&same, reference, "{file}: seed {}", changed.seed);
+        }
     }
 }
 

@@ -6,14 +6,15 @@
 mod spec;
 
 pub use spec::{
-    Derived, DomainKind, FLUID_COUPLING, FluidSpec, FormSpec, GrainSpec, PackingSpec, Process, ShapeKind, SpecError,
-    in_range,
+    Derived, DomainKind, FLUID_COUPLING, FluidSpec, FormSpec, GrainSpec, Orientation, PackingSpec, Process, ShapeKind,
+    SpecError, in_range,
 };
 
+use std::f64::consts::FRAC_PI_2;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use nalgebra::Vector3;
+use nalgebra::{UnitQuaternion, Vector3};
 use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -45,10 +46,9 @@ pub enum PackingError {
     NoGridPositions { spacing: f64 },
     #[error(
         "a grain of bounding radius {radius} m fits inside the domain at no position of the generation \
-         grid (spacing {spacing} m) in any of {ORIENTATIONS} random orientations: widen the domain or narrow \
-         the grains"
+         grid (spacing {spacing} m) {turns}: widen the domain or narrow the grains"
     )]
-    NoRoom { radius: f64, spacing: f64 },
+    NoRoom { radius: f64, spacing: f64, turns: String },
     #[error("not converged after solver.max_time = {0} s of simulated time")]
     NotConverged(f64),
     #[error("the packing has not converged yet")]
@@ -344,7 +344,11 @@ impl Packing {
                 .collect();
             let mut placement = None;
             for _ in 0..ORIENTATIONS {
-                let orientation = uniform_rotation(&mut self.rng);
+                let orientation = match self.spec.process.orientation {
+                    Orientation::Random => uniform_rotation(&mut self.rng),
+                    // A grain's L, I, S lie along its body's x, y, z: turn x up and z across.
+                    Orientation::Upright => UnitQuaternion::from_axis_angle(&Vector3::y_axis(), -FRAC_PI_2),
+                };
                 let reach = shape.horizontal_reach(&orientation);
                 if let Some(&k) =
                     clear.iter().find(|&&k| domain.holds(self.grid[free[k]].x, self.grid[free[k]].y, reach))
@@ -352,13 +356,17 @@ impl Packing {
                     placement = Some((k, orientation));
                     break;
                 }
-                if clear.is_empty() || domain.is_periodic() {
+                if clear.is_empty() || domain.is_periodic() || self.spec.process.orientation == Orientation::Upright {
                     break;
                 }
             }
             let Some((slot, orientation)) = placement else {
                 if self.simulation.bodies.len() == self.set_start {
-                    return Err(PackingError::NoRoom { radius: r, spacing: self.derived.spacing });
+                    let turns = match self.spec.process.orientation {
+                        Orientation::Random => format!("in any of {ORIENTATIONS} random orientations"),
+                        Orientation::Upright => "standing upright (process.generation.orientation)".into(),
+                    };
+                    return Err(PackingError::NoRoom { radius: r, spacing: self.derived.spacing, turns });
                 }
                 self.pending.push(draw);
                 continue;
@@ -535,6 +543,34 @@ mod tests {
             assert!(mass >= target && mass < target + heaviest, "{kind:?}: {mass} kg for {target} kg");
             assert_eq!(packing.grains.len(), b.len());
         }
+    }
+
+    /// The first set of a U1 packing of elongated ellipsoids in the cylinder, created by `orientation`:
+    /// each grain's long axis (body x) and short axis (body z) in the world frame.
+    fn first_set_axes(orientation: Orientation) -> Vec<(Vector3<f64>, Vector3<f64>)> {
+        let mut spec = PackingSpec::paper(DomainKind::Cylinder);
+        spec.grains.form = FormSpec::Single { fl: 0.65, el: 0.5 };
+        spec.process.orientation = orientation;
+        let mut packing = Packing::new(spec).unwrap();
+        packing.generate_set().unwrap();
+        let b = &packing.simulation.bodies;
+        b.orientation.iter().map(|q| (q.transform_vector(&Vector3::x()), q.transform_vector(&Vector3::z()))).collect()
+    }
+
+    #[test]
+    fn upright_grains_stand_on_their_long_axis_with_the_short_one_across_x() {
+        let upright = first_set_axes(Orientation::Upright);
+        assert!(upright.len() > 100, "{} grains", upright.len());
+        for (long, short) in &upright {
+            assert!((long - Vector3::z()).norm() < 1e-12, "{long}");
+            assert!((short.x.abs() - 1.0).abs() < 1e-12, "{short}");
+        }
+        // Turned at random, |cos| of the long axis with the vertical is uniform on [0, 1]: mean
+        // 1/2, std 1/√12 per grain, so within 4 standard errors of 1/2 over the set.
+        let random = first_set_axes(Orientation::Random);
+        let mean = random.iter().map(|(long, _)| long.z.abs()).sum::<f64>() / random.len() as f64;
+        let tolerance = 4.0 / (12.0 * random.len() as f64).sqrt();
+        assert!((mean - 0.5).abs() < tolerance, "mean |cos| {mean} over {} grains", random.len());
     }
 
     /// A grain that no turn fits into the domain is an error naming the grain, not a set that

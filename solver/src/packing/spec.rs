@@ -79,6 +79,18 @@ impl FluidSpec {
         Self { viscosity: WATER.viscosity, flow: Flow::Quiescent, lift: true, cell: None, coupling: None };
 }
 
+/// How a grain lies when it is created; §4.3 does not say.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Orientation {
+    /// Turned uniformly at random, each grain on its own (sedpack's).
+    #[default]
+    Random,
+    /// Every grain alike, its longest axis L vertical and its shortest S along x: how the
+    /// paper's software creates them (waLBerla's `ParticlePacking` keeps a scan as its file lies,
+    /// long axis along z, and sorts a drawn form's axes so).
+    Upright,
+}
+
 /// Process parameters of §4.3 (generation, shaking, damping, convergence).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Process {
@@ -87,6 +99,9 @@ pub struct Process {
     pub spacing: Option<f64>,
     /// Initial speed u_p^init (m/s).
     pub velocity: f64,
+    /// How each new grain is turned.
+    #[serde(default)]
+    pub orientation: Orientation,
     pub shaking: Shaking,
     /// Shaking continues this long after the last grain was created, t_s (s).
     pub shaking_duration: f64,
@@ -192,6 +207,7 @@ impl PackingSpec {
             process: Process {
                 spacing: None,
                 velocity: 1.0,
+                orientation: Orientation::Random,
                 shaking: Shaking { amplitude: 3e-4, period: 0.025 },
                 shaking_duration,
                 damping: 1e-3,
