@@ -268,7 +268,9 @@ pub struct NearestSetup {
 /// Table 3 case and forms apart) and what differs from it, the protocol's keys included.
 pub fn nearest_papers_setup(spec: &PackingSpec) -> NearestSetup {
     let Some(case) = spec.grains.size.case().map(|c| c.name) else {
-        let differences = "its sieve curve is none of Table 3's, the only ones the paper simulated".into();
+        let differences =
+            "its sieve curve is not named as a case of Table 3 (grains.size: U1 … B70), the only ones the paper simulated"
+                .into();
         return NearestSetup { setup: None, differences };
     };
     let kind = if spec.domain.is_periodic() { DomainKind::Periodic } else { DomainKind::Cylinder };

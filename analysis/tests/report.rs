@@ -383,11 +383,23 @@ fn setups_that_are_none_of_the_papers_are_told_the_nearest_and_what_differs() {
     assert!(section[other..].contains(row), "{section}");
     assert!(!section[other..].contains("| grains.size = U1 |"), "{section}");
     // No setup of the paper's: the section still comes, to say so.
-    let records: Vec<JobRecord> = records.into_iter().filter(|r| r.job_id.starts_with("U3")).collect();
+    let mut records: Vec<JobRecord> = records.into_iter().filter(|r| r.job_id.starts_with("U3")).collect();
     let md = std::fs::read_to_string(report("validation", &records, out.path()).markdown).unwrap();
     let section = &md[md.find("## Comparison with the paper's simulations").expect(&md)..];
     assert!(section.contains("No setup of this campaign is one of the paper's simulated setups"), "{section}");
     assert!(section.contains(row), "{section}");
+    // Two setups told the same are one row.
+    let mut other = records.clone();
+    for r in &mut other {
+        r.parameters.insert("grains.size".into(), json!("U5"));
+        r.job_id = r.job_id.replace("U3", "U5");
+        r.porosity -= 0.03;
+    }
+    records.extend(other);
+    let md = std::fs::read_to_string(report("validation", &records, out.path()).markdown).unwrap();
+    let section = &md[md.find("## Comparison with the paper's simulations").expect(&md)..];
+    let one = row.replace("| grains.size = U3 |", "| all 2 setups |");
+    assert!(section.contains(&one), "{section}");
 }
 
 #[test]

@@ -19,7 +19,7 @@ use crate::correlation::CorrelationMatrix;
 use crate::dataset::{Dataset, FeatureKind};
 use crate::form_factors::symbol;
 use crate::model::LinearModel;
-use crate::paper::paper_model;
+use crate::paper::{NearestSetup, paper_model};
 use crate::plots::{self, PlotError, ScatterPlot, ZinggPacking};
 use crate::record::{CampaignSummary, Cost, JobRecord};
 use crate::selection::{Candidate, Selection, SelectionOptions, set_label};
@@ -426,10 +426,23 @@ fn paper_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
         "No setup of this campaign is one of the paper's simulated setups (Tables 5–8 and 11, each by the paper's protocol: see the README's \"sedpack report\"), so there is nothing of the paper's to set its porosity beside. The nearest of the paper's setups to each, and what differs:"
     };
     blocks.push(Block::Paragraph(intro.into()));
-    let rows = others
+    // Setups told the same are one row: a grid over forms is one answer, not one per form.
+    let mut told: Vec<(&NearestSetup, Vec<&str>)> = Vec::new();
+    for ((label, nearest), _) in &others {
+        match told.iter_mut().find(|t| t.0 == nearest) {
+            Some(t) => t.1.push(label),
+            None => told.push((nearest, vec![label])),
+        }
+    }
+    let rows = told
         .iter()
-        .map(|((label, nearest), _)| {
-            vec![label.clone(), nearest.setup.clone().unwrap_or_else(|| "none".into()), nearest.differences.clone()]
+        .map(|(nearest, labels)| {
+            let setups = if !compared && labels.len() > 1 && told.len() == 1 {
+                format!("all {} setups", labels.len())
+            } else {
+                labels.join("; ")
+            };
+            vec![setups, nearest.setup.clone().unwrap_or_else(|| "none".into()), nearest.differences.clone()]
         })
         .collect();
     blocks.push(Block::Table {
