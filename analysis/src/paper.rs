@@ -196,21 +196,41 @@ const SIMULATED: [Simulated; 32] = [
 /// random turns or the paper's software's upright grains) may differ.
 pub fn simulated_porosity(spec: &PackingSpec) -> Option<PaperPorosity> {
     let case = spec.grains.size.case()?.name;
-    let kind = if spec.domain.is_periodic() { DomainKind::Periodic } else { DomainKind::Cylinder };
-    let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b.abs().max(1.0);
-    let row = SIMULATED.iter().find(|s| {
-        s.kind == kind
-            && s.case == case
-            && same(s.width, spec.domain.width())
-            && same(s.mass, spec.grains.mass)
-            && same(s.shaking, spec.process.shaking_duration)
-            && s.form == spec.grains.form
-    })?;
+    let row = SIMULATED.iter().find(|s| row_differences(s, spec, case).is_empty())?;
     follows_papers_protocol(spec, row.form).then(|| PaperPorosity {
         table: row.table.to_string(),
         porosity: row.porosity,
         std: row.std,
     })
+}
+
+fn domain_kind(spec: &PackingSpec) -> DomainKind {
+    if spec.domain.is_periodic() { DomainKind::Periodic } else { DomainKind::Cylinder }
+}
+
+/// What of domain, width, mass, t_s, Table 3 case (`case`, the spec's) and forms `spec` has
+/// apart from `row`, in words; empty when it is the row's setup.
+fn row_differences(row: &Simulated, spec: &PackingSpec, case: &str) -> Vec<String> {
+    let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b.abs().max(1.0);
+    let mut words = Vec::new();
+    if row.kind != domain_kind(spec) {
+        words.push(format!("the {}", domain_words(domain_kind(spec))));
+    } else if !same(row.width, spec.domain.width()) {
+        words.push(format!("L = {} m", spec.domain.width()));
+    }
+    if !same(row.mass, spec.grains.mass) {
+        words.push(format!("{} kg", spec.grains.mass));
+    }
+    if !same(row.shaking, spec.process.shaking_duration) {
+        words.push(format!("t_s = {} s", spec.process.shaking_duration));
+    }
+    if row.case != case {
+        words.push(case.to_string());
+    }
+    if row.form != spec.grains.form {
+        words.push(form_words(spec.grains.form));
+    }
+    words
 }
 
 /// Whether `spec` is the paper's protocol (`PackingSpec::paper` of its domain's kind) for meshes
@@ -227,8 +247,7 @@ fn follows_papers_protocol(spec: &PackingSpec, form: FormSpec) -> bool {
 /// The paper's protocol for meshes of `form` with everything `follows_papers_protocol` lets
 /// differ taken from `spec`, and the spacing and trim its rules give.
 fn papers_protocol(spec: &PackingSpec, form: FormSpec) -> (PackingSpec, Derived) {
-    let kind = if spec.domain.is_periodic() { DomainKind::Periodic } else { DomainKind::Cylinder };
-    let mut papers = PackingSpec::paper(kind);
+    let mut papers = PackingSpec::paper(domain_kind(spec));
     papers.domain = spec.domain;
     papers.grains = GrainSpec {
         shape: ShapeKind::Mesh,
@@ -273,30 +292,7 @@ pub fn nearest_papers_setup(spec: &PackingSpec) -> NearestSetup {
                 .into();
         return NearestSetup { setup: None, differences };
     };
-    let kind = if spec.domain.is_periodic() { DomainKind::Periodic } else { DomainKind::Cylinder };
-    let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b.abs().max(1.0);
-    let apart = |s: &Simulated| {
-        let mut words = Vec::new();
-        if s.kind != kind {
-            words.push(format!("the {}", domain_words(kind)));
-        } else if !same(s.width, spec.domain.width()) {
-            words.push(format!("L = {} m", spec.domain.width()));
-        }
-        if !same(s.mass, spec.grains.mass) {
-            words.push(format!("{} kg", spec.grains.mass));
-        }
-        if !same(s.shaking, spec.process.shaking_duration) {
-            words.push(format!("t_s = {} s", spec.process.shaking_duration));
-        }
-        if s.case != case {
-            words.push(case.to_string());
-        }
-        if s.form != spec.grains.form {
-            words.push(form_words(spec.grains.form));
-        }
-        words
-    };
-    let row = SIMULATED.iter().min_by_key(|s| apart(s).len()).expect("the tables have rows");
+    let row = SIMULATED.iter().min_by_key(|s| row_differences(s, spec, case).len()).expect("the tables have rows");
     // The forms are judged against the row above; the protocol is the rest.
     let (papers, rules) = papers_protocol(spec, spec.grains.form);
     let mut keys = Vec::new();
@@ -310,7 +306,7 @@ pub fn nearest_papers_setup(spec: &PackingSpec) -> NearestSetup {
         keys.push("trim".into());
     }
     let mut differences = Vec::new();
-    let here = apart(row);
+    let here = row_differences(row, spec, case);
     if !here.is_empty() {
         differences.push(format!("this setup has {}", here.join(", ")));
     }

@@ -208,6 +208,7 @@ pub fn job_record(row: &ExportRow, spec: Option<&PackingSpec>) -> anyhow::Result
         .with_context(|| format!("job {}: the stored imbrication is not sedpack's", row.job_id))?;
     let grain_statistics: BTreeMap<_, _> =
         row.grain_statistics.iter().map(|s| (s.name.clone(), (s.mean, s.std))).collect();
+    let paper = spec.and_then(simulated_porosity);
     Ok(Some(JobRecord {
         job_id: row.job_id.clone(),
         porosity: result.porosity,
@@ -215,8 +216,8 @@ pub fn job_record(row: &ExportRow, spec: Option<&PackingSpec>) -> anyhow::Result
         parameters: row.parameters.iter().map(|(k, v)| (k.clone(), v.clone())).collect(),
         size_case: spec.and_then(|s| s.grains.size.case()).map(|c| c.name.to_string()),
         experiment: row.experiment_porosity.map(|porosity| Experiment { porosity, std: row.experiment_std }),
-        paper: spec.and_then(simulated_porosity),
-        paper_nearest: spec.filter(|s| simulated_porosity(s).is_none()).map(nearest_papers_setup),
+        paper_nearest: spec.filter(|_| paper.is_none()).map(nearest_papers_setup),
+        paper,
         paper_model: spec.and_then(|s| model_porosity(s, &grain_statistics)),
         grain_statistics,
         fluid: fluid.map(|f| f.describe()),

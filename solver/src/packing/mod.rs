@@ -153,6 +153,33 @@ pub struct Packing {
 /// grain near the axis fits when it stands steeply enough.
 const ORIENTATIONS: usize = 32;
 
+impl Orientation {
+    /// Turns a new grain tries before it waits for the next set.
+    fn tries(self) -> usize {
+        match self {
+            Orientation::Random => ORIENTATIONS,
+            Orientation::Upright => 1,
+        }
+    }
+
+    /// A new grain's turn.
+    fn turn(self, rng: &mut ChaCha8Rng) -> UnitQuaternion<f64> {
+        match self {
+            Orientation::Random => uniform_rotation(rng),
+            // A grain's L, I, S lie along its body's x, y, z: turn x up and z across.
+            Orientation::Upright => UnitQuaternion::from_axis_angle(&Vector3::y_axis(), -FRAC_PI_2),
+        }
+    }
+
+    /// The turns tried, in words.
+    fn tried(self) -> String {
+        match self {
+            Orientation::Random => format!("in any of {ORIENTATIONS} random orientations"),
+            Orientation::Upright => "standing upright (process.generation.orientation)".into(),
+        }
+    }
+}
+
 /// Steps between checks of whether the last set has left the generation region.
 const GENERATION_CHECK_STEPS: u64 = 100;
 
@@ -331,7 +358,7 @@ impl Packing {
             .filter(|&k| b.position[k].z + b.bounding_radius[k] > floor)
             .map(|k| (b.position[k], b.bounding_radius[k]))
             .collect();
-        let u = self.spec.process.velocity;
+        let (u, rule) = (self.spec.process.velocity, self.spec.process.orientation);
         self.set_start = self.simulation.bodies.len();
         for (draw, shape) in set {
             let r = shape.bounding_radius();
@@ -343,12 +370,8 @@ impl Packing {
                 })
                 .collect();
             let mut placement = None;
-            for _ in 0..ORIENTATIONS {
-                let orientation = match self.spec.process.orientation {
-                    Orientation::Random => uniform_rotation(&mut self.rng),
-                    // A grain's L, I, S lie along its body's x, y, z: turn x up and z across.
-                    Orientation::Upright => UnitQuaternion::from_axis_angle(&Vector3::y_axis(), -FRAC_PI_2),
-                };
+            for _ in 0..rule.tries() {
+                let orientation = rule.turn(&mut self.rng);
                 let reach = shape.horizontal_reach(&orientation);
                 if let Some(&k) =
                     clear.iter().find(|&&k| domain.holds(self.grid[free[k]].x, self.grid[free[k]].y, reach))
@@ -356,17 +379,13 @@ impl Packing {
                     placement = Some((k, orientation));
                     break;
                 }
-                if clear.is_empty() || domain.is_periodic() || self.spec.process.orientation == Orientation::Upright {
+                if clear.is_empty() || domain.is_periodic() {
                     break;
                 }
             }
             let Some((slot, orientation)) = placement else {
                 if self.simulation.bodies.len() == self.set_start {
-                    let turns = match self.spec.process.orientation {
-                        Orientation::Random => format!("in any of {ORIENTATIONS} random orientations"),
-                        Orientation::Upright => "standing upright (process.generation.orientation)".into(),
-                    };
-                    return Err(PackingError::NoRoom { radius: r, spacing: self.derived.spacing, turns });
+                    return Err(PackingError::NoRoom { radius: r, spacing: self.derived.spacing, turns: rule.tried() });
                 }
                 self.pending.push(draw);
                 continue;

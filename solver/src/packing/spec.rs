@@ -80,10 +80,9 @@ impl FluidSpec {
 }
 
 /// How a grain lies when it is created; §4.3 does not say.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Orientation {
     /// Turned uniformly at random, each grain on its own (sedpack's).
-    #[default]
     Random,
     /// Every grain alike, its longest axis L vertical and its shortest S along x: how the
     /// paper's software creates them (waLBerla's `ParticlePacking` keeps a scan as its file lies,
@@ -100,7 +99,6 @@ pub struct Process {
     /// Initial speed u_p^init (m/s).
     pub velocity: f64,
     /// How each new grain is turned.
-    #[serde(default)]
     pub orientation: Orientation,
     pub shaking: Shaking,
     /// Shaking continues this long after the last grain was created, t_s (s).
