@@ -463,6 +463,45 @@ fn cylinder_wall() {
 }
 
 #[test]
+fn the_cylinder_wall_finds_every_contact_a_scan_of_all_vertices_finds() {
+    // Grains near the wall, many within their bounding sphere's reach of it but not touching
+    // (where the wall query may answer without a scan): contact or not, and the depth, must be
+    // those of the farthest vertex from the axis, found here by scanning every vertex.
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let radius = 5.0;
+    let (mut contacts, mut near_but_apart) = (0, 0);
+    for _ in 0..4000 {
+        let shape = random_hull(&mut rng, 60);
+        let rotation = random_rotation(&mut rng);
+        let rho = shape.bounding_radius();
+        let phi = rng.random_range(0.0..std::f64::consts::TAU);
+        let o = radius - rho * rng.random_range(0.25..1.6);
+        let center = V3::new(1.0 + o * phi.cos(), -2.0 + o * phi.sin(), rng.random_range(0.0..3.0));
+        let pose = PolyhedronPose::new(&shape, center, &rotation);
+        let farthest = (0..shape.vertices().len() as u32)
+            .map(|v| (center + pose.vertex(v) - V3::new(1.0, -2.0, 0.0)).xy().norm())
+            .fold(0.0, f64::max);
+        match polyhedron_cylinder_wall(&pose, 1.0, -2.0, radius) {
+            Some(c) => {
+                contacts += 1;
+                assert!(
+                    (c.depth - (farthest - radius)).abs() <= 1e-14 * radius,
+                    "{} vs {}",
+                    c.depth,
+                    farthest - radius
+                );
+            }
+            None => {
+                assert!(farthest <= radius, "missed a contact {:e} deep", farthest - radius);
+                near_but_apart += usize::from(o + rho > radius);
+            }
+        }
+    }
+    // Both answers are well represented (about 1,550 and 650 of the 4,000 draws here).
+    assert!(contacts > 1000 && near_but_apart > 400, "{contacts} contacts, {near_but_apart} near but apart");
+}
+
+#[test]
 fn the_witness_point_against_a_wall_is_the_deepest_vertex_half_the_depth_back() {
     // The rule of the paper's software: one point, at the vertex deepest in the wall, moved back
     // along the normal by half the depth (midway between the vertex and the wall's surface).

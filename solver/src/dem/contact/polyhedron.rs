@@ -504,7 +504,8 @@ fn plane_depth(a: &PolyhedronPose, plane_point: &V3, plane_normal: &V3) -> Optio
 /// and radius, or `None` while the grain lies wholly inside.
 ///
 /// The deepest point is the vertex farthest from the axis (a convex function is largest at a
-/// vertex; all vertices are scanned, so it is exact); depth = its distance from the axis minus
+/// vertex; all vertices are scanned, so it is exact, unless a bound from the grain's support
+/// along the radial and its bounding sphere shows every vertex inside); depth = its distance from the axis minus
 /// the radius, normal = radially outward through it. The point is that of a plane contact with
 /// the wall's tangent plane there, which differs from the curved wall by the sag
 /// (grain width)²/(8 radius) across the contact.
@@ -541,8 +542,20 @@ fn witness_contact(a: &PolyhedronPose, n: &V3, deepest: u32, depth: f64) -> Cont
 /// while A lies wholly inside.
 fn cylinder_depth(a: &PolyhedronPose, axis_x: f64, axis_y: f64, radius: f64) -> Option<(V3, f64, u32, f64)> {
     let offset = V2::new(a.center().x - axis_x, a.center().y - axis_y);
-    if offset.norm() + a.bounding_radius() <= radius {
+    let (o, rho) = (offset.norm(), a.bounding_radius());
+    if o + rho <= radius {
         return None;
+    }
+    // Exact early out, cheaper than the scan: with t = u·h ≤ s (the support along the outward
+    // radial u) and |h − offset| ≤ ρ, |h|² ≤ t² + ρ² − (t − o)² = ρ² − o² + 2 t o ≤ ρ² − o² + 2 s o.
+    // The margin keeps the answer the scan's where rounding could make a graze count.
+    if o > 0.0 {
+        let u = V3::new(offset.x / o, offset.y / o, 0.0);
+        let mut hint = a.cold_hint(&u);
+        let s = o + u.dot(&a.reach(&u, &mut hint));
+        if rho * rho - o * o + 2.0 * s * o <= radius * radius * (1.0 - 1e-12) {
+            return None;
+        }
     }
     let rows = a.map().fixed_rows::<2>(0).into_owned();
     let (far, farthest, deepest) = (0..a.shape().vertices().len() as u32)
