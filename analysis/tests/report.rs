@@ -308,6 +308,25 @@ fn a_single_form_validation_report_has_table_6() {
 }
 
 #[test]
+fn a_ranking_over_seeds_of_one_setup_says_it_measures_the_sampling() {
+    // Three seeds of U1 whose grains' forms differ a little by sampling: the ranking exists
+    // (the features vary) but describes that sampling, and the report says so; with a second
+    // size case in the grid it does not.
+    let mut records = validation_campaign();
+    for (k, r) in records.iter_mut().enumerate() {
+        r.grain_statistics = grain_statistics(&[(0.6 + 0.01 * k as f64, 0.7 - 0.004 * (k * k) as f64); 3]);
+    }
+    let caveat = "**All packings share one setup**";
+    let out = tempfile::tempdir().unwrap();
+    let one = std::fs::read_to_string(report("u1", &records[..3], out.path()).markdown).unwrap();
+    let ranking = one.find("## Feature ranking").expect(&one);
+    assert!(one[ranking..].contains(caveat), "{one}");
+    let out = tempfile::tempdir().unwrap();
+    let two = std::fs::read_to_string(report("u1-u3", &records, out.path()).markdown).unwrap();
+    assert!(two.contains("## Feature ranking") && !two.contains(caveat), "{two}");
+}
+
+#[test]
 fn the_campaign_table_names_the_setup_its_packings_share() {
     let mut records = validation_campaign();
     for r in &mut records {

@@ -68,7 +68,7 @@ pub fn write_report(
     match (dataset, selection) {
         (Some(d), Some(Ok(s))) => {
             dataset_section(&mut blocks, d);
-            ranking_section(&mut blocks, d, s)?;
+            ranking_section(&mut blocks, records, d, s)?;
             if let Some(matrix) = &analysis.factor_correlation {
                 correlation_section(&mut blocks, d.kind(), matrix)?;
             }
@@ -958,8 +958,18 @@ fn dataset_section(blocks: &mut Vec<Block>, d: &Dataset) {
     }
 }
 
-fn ranking_section(blocks: &mut Vec<Block>, d: &Dataset, s: &Selection) -> Result<(), ReportError> {
+fn ranking_section(
+    blocks: &mut Vec<Block>,
+    records: &[JobRecord],
+    d: &Dataset,
+    s: &Selection,
+) -> Result<(), ReportError> {
     blocks.push(Block::Heading("Feature ranking".into()));
+    if records.len() > 1 && grouped(records, |r| Some(setup_label(r))).len() == 1 {
+        blocks.push(Block::Paragraph(
+            "**All packings share one setup** (they differ in seed only): their form statistics differ by the sampling of grains alone, so the correlations and models below describe that sampling, not an effect of form or size. A campaign studies one by varying forms or sizes in its grid.".into(),
+        ));
+    }
     blocks.push(Block::Paragraph(format!(
         "Pearson's correlation coefficient r of every feature with porosity, ranked by |r| (§6.3.2). The primary feature is **`{}`** ({}) with r = {:.3}.",
         s.primary.feature,
