@@ -70,15 +70,49 @@ fn axes(chart: &mut Chart, x_desc: &str, y_desc: &str, x: (f64, f64), y: (f64, f
         .draw()
 }
 
-/// The series' legend in the upper left, on a translucent white box.
-fn legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, font: u32) -> Drawn {
+/// The series' legend in a corner of the plot (`corner`, upper left by default), on a
+/// translucent white box.
+fn legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, font: u32, corner: Corner) -> Drawn {
+    let position = match corner {
+        Corner::UpperLeft => SeriesLabelPosition::UpperLeft,
+        Corner::UpperRight => SeriesLabelPosition::UpperRight,
+        Corner::LowerLeft => SeriesLabelPosition::LowerLeft,
+        Corner::LowerRight => SeriesLabelPosition::LowerRight,
+    };
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
+        .position(position)
         .label_font((FONT, font))
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK.mix(0.4))
         .draw()
+}
+
+/// A corner of a plot, for its legend.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Corner {
+    UpperLeft,
+    UpperRight,
+    LowerLeft,
+    LowerRight,
+}
+
+/// The corner whose box of half the width and a third of the height (about a legend of a few
+/// lines) holds the fewest of `points`, upper left first among equals.
+fn emptiest_corner(points: &[(f64, f64)], x: (f64, f64), y: (f64, f64)) -> Corner {
+    let middle = 0.5 * (x.0 + x.1);
+    let (low, high) = (y.0 + (y.1 - y.0) / 3.0, y.1 - (y.1 - y.0) / 3.0);
+    let count = |inside: &dyn Fn(f64, f64) -> bool| points.iter().filter(|p| inside(p.0, p.1)).count();
+    [
+        (Corner::UpperLeft, count(&|px, py| px <= middle && py >= high)),
+        (Corner::UpperRight, count(&|px, py| px >= middle && py >= high)),
+        (Corner::LowerLeft, count(&|px, py| px <= middle && py <= low)),
+        (Corner::LowerRight, count(&|px, py| px >= middle && py <= low)),
+    ]
+    .into_iter()
+    .min_by_key(|c| c.1)
+    .expect("four corners")
+    .0
 }
 
 /// [min, max] of finite values widened by 5 % (or ±0.5 % of the value for a single value),
@@ -193,7 +227,7 @@ pub fn scatter(plot: &ScatterPlot) -> Result<String, PlotError> {
                 .label(legend.as_str())
                 .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], RED.stroke_width(2)));
         }
-        legend(&mut chart, 13)
+        legend(&mut chart, 13, emptiest_corner(plot.points, x, y))
     })
 }
 
@@ -249,7 +283,7 @@ pub fn series_with_spread(title: &str, x_label: &str, y_label: &str, series: &[S
                 .label(s.label.as_str())
                 .legend(move |(x, y)| Circle::new((x + 7, y), 4, colour.filled()));
         }
-        legend(&mut chart, 13)
+        legend(&mut chart, 13, Corner::UpperLeft)
     })
 }
 
@@ -277,7 +311,9 @@ pub fn predicted_vs_observed(
             .draw_series(observed.iter().zip(fitted).map(|(&o, &p)| Circle::new((o, p), 3, STEEL.filled())))?
             .label("fitted on all packings")
             .legend(|(x, y)| Circle::new((x + 7, y), 3, STEEL.filled()));
-        legend(&mut chart, 13)
+        let points: Vec<(f64, f64)> =
+            observed.iter().zip(fitted).chain(observed.iter().zip(held_out)).map(|(&o, &p)| (o, p)).collect();
+        legend(&mut chart, 13, emptiest_corner(&points, (lo, hi), (lo, hi)))
     })
 }
 
@@ -357,7 +393,7 @@ pub fn profiles(profiles: &[(String, Vec<ProfilePoint>)]) -> Result<String, Plot
             }
         }
         if with_legend {
-            legend(&mut chart, 12)?;
+            legend(&mut chart, 12, Corner::UpperLeft)?;
         }
         Ok(())
     })
@@ -400,6 +436,20 @@ mod tests {
         // the two points.
         assert_eq!(elements(&measured, "polyline", stroke), 1, "{measured}");
         assert!(elements(&model, "polyline", stroke) > 30, "{model}");
+    }
+
+    #[test]
+    fn the_legend_goes_where_it_hides_fewest_points() {
+        let (x, y) = ((0.0, 1.0), (0.0, 1.0));
+        // A falling line of points (Fig. 8 with r < 0) fills the upper left and lower right.
+        let falling: Vec<(f64, f64)> = (0..=10).map(|k| (0.1 * k as f64, 1.0 - 0.1 * k as f64)).collect();
+        assert_eq!(emptiest_corner(&falling, x, y), Corner::UpperRight);
+        // A rising one (Figs. 9 and 12, on the 1:1 line) leaves the upper left free.
+        let rising: Vec<(f64, f64)> = falling.iter().map(|p| (p.0, 1.0 - p.1)).collect();
+        assert_eq!(emptiest_corner(&rising, x, y), Corner::UpperLeft);
+        // Points everywhere but the lower left.
+        let spread = [(0.1, 0.9), (0.9, 0.9), (0.9, 0.1), (0.2, 0.8), (0.8, 0.2), (0.8, 0.8)];
+        assert_eq!(emptiest_corner(&spread, x, y), Corner::LowerLeft);
     }
 
     #[test]

@@ -146,8 +146,13 @@ pub fn escape(s: &str) -> String {
 
 /// Escaped text with `code` and **strong** marks turned into elements.
 fn inline(s: &str) -> String {
+    marks(&escape(s))
+}
+
+/// [`inline`] on text already escaped; code may stand inside strong (**`name`**).
+fn marks(escaped: &str) -> String {
     let mut out = String::new();
-    let mut rest = escape(s);
+    let mut rest = escaped.to_string();
     while !rest.is_empty() {
         let code = rest.find('`');
         let strong = rest.find("**");
@@ -159,7 +164,8 @@ fn inline(s: &str) -> String {
         };
         let after = &rest[at + mark.len()..];
         let Some(end) = after.find(mark) else { break };
-        let _ = write!(out, "{}<{tag}>{}</{tag}>", &rest[..at], &after[..end]);
+        let inner = if tag == "strong" { marks(&after[..end]) } else { after[..end].to_string() };
+        let _ = write!(out, "{}<{tag}>{inner}</{tag}>", &rest[..at]);
         rest = after[end + mark.len()..].to_string();
     }
     out.push_str(&rest);
@@ -180,6 +186,7 @@ mod tests {
     fn inline_marks_become_elements_and_text_is_escaped() {
         assert_eq!(inline("a `x<y` and **b & c**"), "a <code>x&lt;y</code> and <strong>b &amp; c</strong>");
         assert_eq!(inline("unclosed `mark"), "unclosed `mark");
+        assert_eq!(inline("is **`inv_EQ`** (x)"), "is <strong><code>inv_EQ</code></strong> (x)");
         assert!(is_numeric("**4.26**"));
         assert!(is_numeric("0.383 ± 0.002"));
         assert!(is_numeric("−0.011"));
