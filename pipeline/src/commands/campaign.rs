@@ -346,8 +346,12 @@ pub(crate) async fn catch_up(store: &Store, db: &Path, name: &str) -> anyhow::Re
 struct StatusRecord {
     #[serde(flatten)]
     status: CampaignStatus,
-    /// Wall time left for one worker (s), by [`time_left`].
+    /// Wall time left for one worker (s) by [`TimeLeft`], for the jobs whose setup has a done job.
     estimated_time_left: Option<f64>,
+    /// Jobs left whose setup has no done job yet, which the estimate leaves out.
+    jobs_not_estimated: usize,
+    #[serde(skip)]
+    time_left: Option<TimeLeft>,
     executor: Executor,
     /// A Slurm campaign's jobs beside their tasks' states in Slurm.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -357,43 +361,132 @@ struct StatusRecord {
 async fn status_record(store: &Store, db: &Path, name: &str) -> anyhow::Result<StatusRecord> {
     let caught_up = catch_up(store, db, name).await?;
     let status = store.status(name).await?;
-    let left = time_left(&status);
+    let checkpoints: HashMap<&str, f64> =
+        status.in_progress.iter().filter_map(|p| Some((p.job_id.as_str(), p.checkpoint?.0))).collect();
+    let jobs: Vec<Weighed> = store
+        .export(name)
+        .await?
+        .iter()
+        .map(|row| Weighed {
+            setup: setup_key(&row.parameters),
+            ended: matches!(row.state, JobState::Done | JobState::Failed),
+            done: row.result.as_ref().filter(|_| row.state == JobState::Done).map(|r| (r.wall_time, r.simulated_time)),
+            checkpoint: checkpoints.get(row.job_id.as_str()).copied(),
+        })
+        .collect();
+    let time_left = TimeLeft::of(&jobs);
     let (executor, tasks) = match caught_up {
         None => (Executor::Local, None),
         Some((executor, run)) => (executor, Some(slurm::task_rows(store, &run, name).await?)),
     };
-    Ok(StatusRecord { status, estimated_time_left: left, executor, tasks })
+    Ok(StatusRecord {
+        status,
+        estimated_time_left: time_left.as_ref().map(|t| t.seconds),
+        jobs_not_estimated: time_left.as_ref().map_or(0, |t| t.unestimated),
+        time_left,
+        executor,
+        tasks,
+    })
 }
 
-/// The share of a done job's mean simulated time that each checkpoint of a job in progress has
-/// already simulated (above 1 for a job past it); none before a done job's simulated time is known.
-fn simulated_shares(s: &CampaignStatus) -> impl Iterator<Item = f64> + '_ {
-    let mean = s.mean_simulated_time_done.filter(|&t| t > 0.0);
-    s.in_progress.iter().filter_map(move |p| Some(p.checkpoint?.0 / mean?))
+/// A job's setup: its grid values but the seed.
+fn setup_key(parameters: &Map<String, Value>) -> String {
+    let setup: Map<String, Value> =
+        parameters.iter().filter(|(k, _)| k.as_str() != "seed").map(|(k, v)| (k.clone(), v.clone())).collect();
+    Value::Object(setup).to_string()
 }
 
-/// Wall time left for one worker (s): a done job's mean wall time for every pending or running
-/// job, less, for each with a checkpoint, its simulated share (at most all of it). None before a
-/// job is done.
-fn time_left(s: &CampaignStatus) -> Option<f64> {
-    let wall = s.mean_wall_time_done?;
-    let covered: f64 = simulated_shares(s).map(|share| share.min(1.0)).sum();
-    Some(wall * ((s.pending + s.running) as f64 - covered).max(0.0))
+/// One job as the time left weighs it: its setup, whether it has ended, a done job's wall and
+/// simulated time, and the simulated time of the last checkpoint of one in progress.
+struct Weighed {
+    setup: String,
+    ended: bool,
+    done: Option<(f64, f64)>,
+    checkpoint: Option<f64>,
 }
 
-/// The time left in words, with what it is based on and the jobs it cannot weigh (those that
-/// have simulated more than a done job count as ending now); None once every job has ended.
-fn time_left_text(s: &CampaignStatus) -> Option<String> {
-    let (left, wall) = (time_left(s)?, s.mean_wall_time_done?);
-    if s.pending + s.running == 0 {
-        return None;
+/// Wall time left for one worker: every job left takes as long as the done jobs of its setup did
+/// on average, less the share of their simulated time its checkpoint has already simulated.
+/// Setups differ widely (a bimodal sieve curve pours several times a unimodal one's grains), so
+/// a job whose setup has no done job is not estimated.
+#[derive(Debug, Clone, PartialEq)]
+struct TimeLeft {
+    seconds: f64,
+    /// Jobs left whose setup has a done job.
+    estimated: usize,
+    /// Of those, the jobs already past their setup's done jobs' simulated time (counted as ending now).
+    past: usize,
+    /// Jobs left whose setup has no done job.
+    unestimated: usize,
+    /// A done job's mean wall and simulated time, when every job shares one setup.
+    one_setup: Option<(f64, f64)>,
+}
+
+impl TimeLeft {
+    /// None before a job is done or once every job has ended.
+    fn of(jobs: &[Weighed]) -> Option<Self> {
+        let mut done: HashMap<&str, (f64, f64, usize)> = HashMap::new();
+        for job in jobs {
+            if let Some((wall, simulated)) = job.done {
+                let sums = done.entry(job.setup.as_str()).or_default();
+                *sums = (sums.0 + wall, sums.1 + simulated, sums.2 + 1);
+            }
+        }
+        let left: Vec<&Weighed> = jobs.iter().filter(|j| !j.ended).collect();
+        if done.is_empty() || left.is_empty() {
+            return None;
+        }
+        let mean = |setup: &str| done.get(setup).map(|&(wall, simulated, n)| (wall / n as f64, simulated / n as f64));
+        let mut t = TimeLeft { seconds: 0.0, estimated: 0, past: 0, unestimated: 0, one_setup: None };
+        for job in left {
+            let Some((wall, simulated)) = mean(&job.setup) else {
+                t.unestimated += 1;
+                continue;
+            };
+            let share = job.checkpoint.filter(|_| simulated > 0.0).map_or(0.0, |c| c / simulated);
+            t.estimated += 1;
+            t.past += usize::from(share >= 1.0);
+            t.seconds += wall * (1.0 - share.min(1.0));
+        }
+        let first = &jobs[0].setup;
+        if jobs.iter().all(|j| &j.setup == first) {
+            t.one_setup = mean(first);
+        }
+        Some(t)
     }
-    let simulated = s.mean_simulated_time_done.map(|t| format!(" for {t:.2} s simulated")).unwrap_or_default();
-    let past = match simulated_shares(s).filter(|&share| share >= 1.0).count() {
-        0 => String::new(),
-        k => format!("; {k} job(s) already past that, whose end is not estimated"),
-    };
-    Some(format!("≈ {} for one worker (a done job took {}{simulated}){past}", duration(left), duration(wall)))
+
+    /// In words, with what the estimate rests on and the jobs it leaves out.
+    fn text(&self) -> String {
+        let past = |what: &str| match self.past {
+            0 => String::new(),
+            k => format!("; {k} job(s) already past {what}, whose end is not estimated"),
+        };
+        if let Some((wall, simulated)) = self.one_setup {
+            let simulated = if simulated > 0.0 { format!(" for {simulated:.2} s simulated") } else { String::new() };
+            return format!(
+                "≈ {} for one worker (a done job took {}{simulated}){}",
+                duration(self.seconds),
+                duration(wall),
+                past("that")
+            );
+        }
+        let not = match self.unestimated {
+            0 => String::new(),
+            k => format!("; {k} job(s) of setups without a done job are not estimated"),
+        };
+        if self.estimated == 0 {
+            return format!(
+                "not estimated: none of the {} job(s) left shares its setup with a done job",
+                self.unestimated
+            );
+        }
+        format!(
+            "≈ {} for one worker for {} job(s), each as long as its setup's done jobs took{}{not}",
+            duration(self.seconds),
+            self.estimated,
+            past("those")
+        )
+    }
 }
 
 pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
@@ -430,8 +523,8 @@ pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
                     ),
                 )
                 .row("time spent", format!("{} on finished jobs", duration(s.wall_time_finished)));
-            if let Some(text) = time_left_text(s) {
-                table.row("time left", text);
+            if let Some(t) = &r.time_left {
+                table.row("time left", t.text());
             }
             for f in &s.failures {
                 table.row(format!("failed {}", f.job_id), f.error.clone());
@@ -615,53 +708,69 @@ mod tests {
         );
     }
 
+    fn weighed(setup: &str, ended: bool, done: Option<(f64, f64)>, checkpoint: Option<f64>) -> Weighed {
+        Weighed { setup: setup.into(), ended, done, checkpoint }
+    }
+
     #[test]
     fn the_time_left_counts_what_the_checkpoints_have_already_simulated() {
-        // Done jobs took 100 s of wall time for 2 s simulated on average. Left: one pending job
-        // without a checkpoint (100 s), one running at 1.5 s (a quarter left: 25 s) and one
-        // pending at 2.5 s, past the mean (nothing counted): 125 s.
-        let job = |state, simulated: Option<f64>| Progress {
-            job_id: "a".into(),
-            state,
-            worker_id: None,
-            attempts: 1,
-            started_at: None,
-            checkpoint: simulated.map(|t| (t, 0.0)),
-            stage: None,
-        };
-        let mut status = CampaignStatus {
-            campaign: "c".into(),
-            jobs: 5,
-            pending: 2,
-            running: 1,
-            done: 2,
-            failed: 0,
-            failures: vec![],
-            wall_time_finished: 200.0,
-            mean_wall_time_done: Some(100.0),
-            mean_simulated_time_done: Some(2.0),
-            in_progress: vec![job(JobState::Running, Some(1.5)), job(JobState::Pending, Some(2.5))],
-        };
-        assert_eq!(time_left(&status), Some(125.0));
+        // One setup; done jobs took 100 s of wall time for 2 s simulated on average (80 s for
+        // 1.8 s, 120 s for 2.2 s). Left: one pending job without a checkpoint (100 s), one
+        // running at 1.5 s (a quarter left: 25 s) and one pending at 2.5 s, past the mean
+        // (nothing counted): 125 s. A failed job is not waited for.
+        let mut jobs = vec![
+            weighed("{}", true, Some((80.0, 1.8)), None),
+            weighed("{}", true, Some((120.0, 2.2)), None),
+            weighed("{}", true, None, None),
+            weighed("{}", false, None, None),
+            weighed("{}", false, None, Some(1.5)),
+            weighed("{}", false, None, Some(2.5)),
+        ];
+        let t = TimeLeft::of(&jobs).unwrap();
+        assert_eq!((t.seconds, t.estimated, t.past, t.unestimated), (125.0, 3, 1, 0));
         assert_eq!(
-            time_left_text(&status).as_deref(),
-            Some(
-                "≈ 2 min 05 s for one worker (a done job took 1 min 40 s for 2.00 s simulated); 1 job(s) already \
-                 past that, whose end is not estimated"
-            )
+            t.text(),
+            "≈ 2 min 05 s for one worker (a done job took 1 min 40 s for 2.00 s simulated); 1 job(s) already past \
+             that, whose end is not estimated"
         );
-        // Without a done job's simulated time, checkpoints cannot be weighed: every job counts whole.
-        status.mean_simulated_time_done = None;
-        assert_eq!(time_left(&status), Some(300.0));
+        // Nothing left to run, or nothing done yet: no estimate.
+        let ended: Vec<Weighed> = jobs.iter().filter(|j| j.ended).map(|j| weighed("{}", true, j.done, None)).collect();
+        assert_eq!(TimeLeft::of(&ended), None);
+        jobs.retain(|j| j.done.is_none());
+        assert_eq!(TimeLeft::of(&jobs), None);
+    }
+
+    #[test]
+    fn the_time_left_weighs_each_job_by_the_done_jobs_of_its_setup() {
+        // U3 took 480 s for 2.9 s simulated, U5 1,500 s and 1,700 s for 8 s: U3's second seed
+        // 480 s, U5's third 1,600 s less the half its checkpoint at 4 s covers (800 s); B70 has
+        // no done job and is not estimated, whatever U3 and U5 took.
+        let (u3, u5, b70) = (r#"{"grains.size":"U3"}"#, r#"{"grains.size":"U5"}"#, r#"{"grains.size":"B70"}"#);
+        let mut jobs = vec![
+            weighed(u3, true, Some((480.0, 2.9)), None),
+            weighed(u5, true, Some((1500.0, 8.0)), None),
+            weighed(u5, true, Some((1700.0, 8.0)), None),
+            weighed(u3, false, None, None),
+            weighed(u5, false, None, Some(4.0)),
+            weighed(b70, false, None, None),
+            weighed(b70, false, None, None),
+        ];
+        let t = TimeLeft::of(&jobs).unwrap();
+        assert_eq!((t.seconds, t.estimated, t.past, t.unestimated, t.one_setup), (1280.0, 2, 0, 2, None));
         assert_eq!(
-            time_left_text(&status).as_deref(),
-            Some("≈ 5 min 00 s for one worker (a done job took 1 min 40 s)")
+            t.text(),
+            "≈ 21 min 20 s for one worker for 2 job(s), each as long as its setup's done jobs took; 2 job(s) of \
+             setups without a done job are not estimated"
         );
-        // Nothing left to run: no estimate to print.
-        let ended = CampaignStatus { pending: 0, running: 0, in_progress: vec![], ..status.clone() };
-        assert_eq!(time_left_text(&ended), None);
-        status.mean_wall_time_done = None;
-        assert_eq!(time_left(&status), None);
+        jobs.retain(|j| j.ended || j.setup == b70);
+        assert_eq!(
+            TimeLeft::of(&jobs).unwrap().text(),
+            "not estimated: none of the 2 job(s) left shares its setup with a done job"
+        );
+        // The setup is the grid values but the seed.
+        let key = |json: &str| setup_key(serde_json::from_str::<Value>(json).unwrap().as_object().unwrap());
+        assert_eq!(key(r#"{"seed":1,"grains.size":"U3"}"#), key(r#"{"grains.size":"U3","seed":2}"#));
+        assert_ne!(key(r#"{"seed":1,"grains.size":"U3"}"#), key(r#"{"seed":1,"grains.size":"U5"}"#));
     }
 
     #[test]
