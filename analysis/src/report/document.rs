@@ -61,7 +61,8 @@ const STYLE: &str = "body{font-family:sans-serif;max-width:1100px;margin:2em aut
 div.table{max-width:100%;overflow-x:auto}table{border-collapse:collapse;margin:1em 0;font-size:0.92em}\
 th,td{border:1px solid #bbb;padding:0.25em 0.6em;text-align:left;vertical-align:top;overflow-wrap:anywhere}\
 summary{cursor:pointer;color:#335}\
-th{background:#eee}td.num{text-align:right;font-variant-numeric:tabular-nums}\
+th{background:#eee;overflow-wrap:normal}td.num{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}\
+td code,th code{white-space:nowrap}\
 code{background:#f3f3f3;padding:0 0.2em}figure{margin:1.5em 0}svg{max-width:100%;height:auto}\
 figcaption{font-style:italic;margin-top:0.3em}";
 
