@@ -70,8 +70,7 @@ fn axes(chart: &mut Chart, x_desc: &str, y_desc: &str, x: (f64, f64), y: (f64, f
         .draw()
 }
 
-/// The series' legend in a corner of the plot (`corner`, upper left by default), on a
-/// translucent white box.
+/// The series' legend in `corner` of the plot, on a translucent white box.
 fn legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, font: u32, corner: Corner) -> Drawn {
     let position = match corner {
         Corner::UpperLeft => SeriesLabelPosition::UpperLeft,

@@ -505,8 +505,8 @@ fn plane_depth(a: &PolyhedronPose, plane_point: &V3, plane_normal: &V3) -> Optio
 ///
 /// The deepest point is the vertex farthest from the axis (a convex function is largest at a
 /// vertex; all vertices are scanned, so it is exact, unless a bound from the grain's support
-/// along the radial and its bounding sphere shows every vertex inside); depth = its distance from the axis minus
-/// the radius, normal = radially outward through it. The point is that of a plane contact with
+/// along the radial and its bounding sphere shows every vertex inside); depth = its distance
+/// from the axis minus the radius, normal = radially outward through it. The point is that of a plane contact with
 /// the wall's tangent plane there, which differs from the curved wall by the sag
 /// (grain width)²/(8 radius) across the contact.
 pub fn polyhedron_cylinder_wall(a: &PolyhedronPose, axis_x: f64, axis_y: f64, radius: f64) -> Option<ContactGeometry> {
