@@ -209,6 +209,11 @@ pub struct ContinueArgs {
     /// No progress bars.
     #[arg(long)]
     pub quiet: bool,
+    /// Run (or submit to Slurm) only the pending jobs whose grid value KEY is VALUE, e.g.
+    /// `--only grains.size=B50 --only seed=1`; given again with the same KEY, any of its values
+    /// (the others stay pending for a later `resume`).
+    #[arg(long, value_name = "KEY=VALUE")]
+    pub only: Vec<String>,
 }
 
 #[derive(Debug, Args)]

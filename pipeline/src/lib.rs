@@ -1,8 +1,9 @@
 //! The sedpack pipeline: the command line, campaign files and the runner. This is the only
 //! crate that knows the solver, the store and the analysis together. A job file is parsed
 //! (`job_file`), resolved into a checked `JobSpec` (`spec`) and expanded into a campaign's jobs
-//! (`campaign`); each is stored in its numbered format (`stored`) and run (`runner`); store rows
-//! and analysis records meet in `records`.
+//! (`campaign`); each is stored in its numbered format (`stored`) and run (`runner`), all of a
+//! campaign's pending jobs or those `--only` picks (`selection`); store rows and analysis records
+//! meet in `records`.
 
 pub mod campaign;
 pub mod cli;
@@ -13,6 +14,7 @@ pub mod meshes;
 pub mod output;
 pub mod records;
 pub mod runner;
+pub mod selection;
 pub mod slurm;
 pub mod spec;
 pub mod stored;

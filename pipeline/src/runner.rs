@@ -46,6 +46,8 @@ pub struct RunOptions {
     /// Start over the jobs whose checkpoints another version of sedpack wrote; without it such
     /// a job stops the run before its packing starts, job and checkpoint left as they were.
     pub discard_old_checkpoints: bool,
+    /// Run only these jobs (`--only`); the others stay pending.
+    pub only: Option<Vec<String>>,
 }
 
 /// A pending job's checkpoint that this version cannot continue.
@@ -211,6 +213,7 @@ pub async fn run(store: &Store, campaign: &str, options: &RunOptions, interactiv
             threads: options.threads,
             checkpoint_interval: options.checkpoint_interval,
             discard_old_checkpoints: options.discard_old_checkpoints,
+            only: options.only.clone(),
             cancel: cancel.clone(),
             bar,
             total: total.clone(),
@@ -248,6 +251,7 @@ struct Worker {
     threads: usize,
     checkpoint_interval: Duration,
     discard_old_checkpoints: bool,
+    only: Option<Vec<String>>,
     cancel: Arc<AtomicBool>,
     bar: ProgressBar,
     total: ProgressBar,
@@ -269,7 +273,7 @@ impl Worker {
         let mut summary = Summary::default();
         let pool = Arc::new(rayon::ThreadPoolBuilder::new().num_threads(self.threads).build()?);
         while !self.cancel.load(Ordering::SeqCst) {
-            let claimed = match self.store.claim(&self.campaign, &self.id).await? {
+            let claimed = match self.store.claim(&self.campaign, &self.id, self.only.as_deref()).await? {
                 Some(job) => job,
                 // Nothing pending: jobs of runners that died meanwhile may be waiting.
                 None if recover(&self.store, &self.campaign).await? > 0 => continue,

@@ -76,6 +76,54 @@ fn a_grid_campaign_runs_once_and_reports() {
 }
 
 #[test]
+fn only_runs_the_jobs_of_the_grid_values_asked_for_and_leaves_the_others_pending() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "only.yaml", &campaign("only", 0.05));
+    let db = &path_in(dir.path(), "only.db");
+    // A value no job has is refused before anything is stored.
+    fails(
+        &["run", &file, "--db", db, "--only", "material.friction=0.3"],
+        &["--only material.friction=0.3", "no job of campaign only has material.friction = 0.3", "0.0, 0.5"],
+    );
+    assert!(!Path::new(db).exists() || rows(db, "only").is_empty(), "nothing stored");
+
+    let first = ok(&["run", &file, "--db", db, "--quiet", "--only", "material.friction=0.5"]);
+    assert!(
+        first.contains("--only picks 2 job(s), 2 of them pending") && first.contains("2 job(s) finished now"),
+        "{first}"
+    );
+    let by_state = |state: JobState| -> Vec<(f64, u64)> {
+        let mut out: Vec<(f64, u64)> = rows(db, "only")
+            .iter()
+            .filter(|r| r.state == state)
+            .map(|r| (r.parameters["material.friction"].as_f64().unwrap(), r.seed))
+            .collect();
+        out.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        out
+    };
+    assert_eq!(by_state(JobState::Done), [(0.5, 1), (0.5, 2)]);
+    assert_eq!(by_state(JobState::Pending), [(0.0, 1), (0.0, 2)]);
+
+    // The seed is a grid value too; a key given twice takes either value.
+    let second = ok(&["resume", "only", "--db", db, "--quiet", "--only", "seed=1"]);
+    assert!(
+        second.contains("--only picks 2 job(s), 1 of them pending") && second.contains("1 job(s) finished now"),
+        "{second}"
+    );
+    assert_eq!(by_state(JobState::Pending), [(0.0, 2)]);
+    fails(
+        &["resume", "only", "--db", db, "--only", "friction=0.0"],
+        &["friction is not a grid value of campaign only", "its jobs have: material.friction, seed"],
+    );
+    let last = ok(&["resume", "only", "--db", db, "--quiet", "--only", "seed=2", "--only", "seed=1"]);
+    assert!(
+        last.contains("--only picks 4 job(s), 1 of them pending") && last.contains("1 job(s) finished now"),
+        "{last}"
+    );
+    assert!(by_state(JobState::Pending).is_empty());
+}
+
+#[test]
 fn a_saved_model_predicts_what_its_formula_gives() {
     // A model file as `sedpack report` writes it, with features the §7.3 relations can give.
     let dir = tempfile::tempdir().unwrap();

@@ -38,6 +38,7 @@ async fn a_failing_worker_stops_the_others_and_every_job_returns_to_pending() {
         threads: 1,
         checkpoint_interval: Duration::from_secs(300),
         discard_old_checkpoints: false,
+        only: None,
     };
     let error = run(&store, &campaign.name, &options, false).await.unwrap_err();
     let error = format!("{error:#}");
@@ -60,7 +61,7 @@ async fn a_checkpoint_of_another_version_stops_the_run_untouched_unless_discardi
 
     // An older sedpack ran the job to t = 2.5 s and was stopped: its checkpoint starts with
     // format number 3 (one varint byte), followed by a packing this version cannot decode.
-    let claimed = store.claim(&campaign.name, "old-sedpack").await.unwrap().unwrap();
+    let claimed = store.claim(&campaign.name, "old-sedpack", None).await.unwrap().unwrap();
     let old = [3u8, 0x2a, 0x07, 0x00, 0x13];
     store.save_checkpoint(&claimed.id, "old-sedpack", &old, 2.5, None).await.unwrap();
     assert!(store.release(&claimed.id, "old-sedpack").await.unwrap());
@@ -71,6 +72,7 @@ async fn a_checkpoint_of_another_version_stops_the_run_untouched_unless_discardi
         threads: 1,
         checkpoint_interval: Duration::from_secs(300),
         discard_old_checkpoints: false,
+        only: None,
     };
     let error = format!("{:#}", run(&store, &campaign.name, &options, false).await.unwrap_err());
     let named = format!("{} (format 3, at t = 2.50 s)", claimed.id);

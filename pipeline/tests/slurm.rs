@@ -203,6 +203,29 @@ fn a_campaign_runs_in_slurm_to_the_local_executors_results() {
 }
 
 #[test]
+fn only_submits_the_jobs_of_the_grid_values_asked_for() {
+    let Some(_slurm) = slurm() else { return };
+    let _one = CLUSTER.lock().unwrap_or_else(|e| e.into_inner());
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "only.yaml", &tiny_campaign("only", "executor: {kind: slurm}\n"));
+    let db = &path_in(dir.path(), "only.db");
+    let out =
+        ok(&["run", &file, "--db", db, "--wait", "--quiet", "--only", "material.friction=0.25", "--only", "seed=2"]);
+    assert!(out.contains("--only picks 1 job(s), 1 of them pending"), "{out}");
+    assert!(out.contains("only: 1 done, 0 failed, 11 pending, 0 in Slurm"), "{out}");
+    let done: Vec<(f64, u64)> = rows(db, "only")
+        .iter()
+        .filter(|r| r.state == JobState::Done)
+        .map(|r| (r.parameters["material.friction"].as_f64().unwrap(), r.seed))
+        .collect();
+    assert_eq!(done, [(0.25, 2)]);
+    // Only that job's task ran: one task output in the run directory.
+    assert_eq!(std::fs::read_dir(dir.path().join("only.runs/only/logs")).unwrap().count(), 1);
+    let rest = ok(&["resume", "only", "--db", db, "--wait", "--quiet"]);
+    assert!(rest.contains("only: 12 done, 0 failed, 0 pending, 0 in Slurm"), "{rest}");
+}
+
+#[test]
 fn killed_submitters_scancel_requeue_and_preemption_lose_nothing_and_run_nothing_twice() {
     let Some(slurm) = slurm() else { return };
     let _one = CLUSTER.lock().unwrap_or_else(|e| e.into_inner());

@@ -148,9 +148,16 @@ impl Store {
         Ok(added)
     }
 
-    /// Hands the campaign's next pending job (in submission order) to `worker_id`, or None if no
-    /// job is pending. No two claimers, in this process or another, ever get the same job.
-    pub async fn claim(&self, campaign: &str, worker_id: &str) -> Result<Option<ClaimedJob>, StoreError> {
+    /// Hands the campaign's next pending job (in submission order; of those in `only`, if given)
+    /// to `worker_id`, or None if no such job is pending. No two claimers, in this process or
+    /// another, ever get the same job.
+    pub async fn claim(
+        &self,
+        campaign: &str,
+        worker_id: &str,
+        only: Option<&[String]>,
+    ) -> Result<Option<ClaimedJob>, StoreError> {
+        let only = only.map(|ids| self.encode_json(&ids, "job ids")).transpose()?;
         let mut conn = self.pool.acquire().await.map_err(self.db())?;
         let campaign_id = self.campaign_id(&mut conn, campaign).await?;
         // One UPDATE … RETURNING takes the write lock before it reads, so the pick is atomic.
@@ -158,6 +165,7 @@ impl Store {
             .bind(campaign_id)
             .bind(worker_id)
             .bind(now())
+            .bind(only)
             .fetch_optional(&mut *conn)
             .await
             .map_err(self.db())?;

@@ -32,7 +32,9 @@ pub const CLAIM_JOB: &str = "
     SET state = 'running', attempts = attempts + 1, worker_id = ?2,
         started_at = ?3, heartbeat_at = ?3, finished_at = NULL, wall_time = NULL, error = NULL
     WHERE state = 'pending' AND id = (
-        SELECT id FROM jobs WHERE campaign_id = ?1 AND state = 'pending' ORDER BY rowid LIMIT 1)
+        SELECT id FROM jobs
+        WHERE campaign_id = ?1 AND state = 'pending' AND (?4 IS NULL OR id IN (SELECT value FROM json_each(?4)))
+        ORDER BY rowid LIMIT 1)
     RETURNING id, format, spec, seed, parameters, attempts";
 pub const CLAIM_JOBS: &str = "
     UPDATE jobs

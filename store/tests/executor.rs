@@ -30,7 +30,7 @@ async fn a_campaign_keeps_its_executor() {
 async fn many_jobs_are_claimed_at_once_each_by_its_own_worker() {
     let dir = tempfile::tempdir().unwrap();
     let store = store_with_jobs(&db_path(&dir), 5).await;
-    let first = store.claim(CAMPAIGN, "local").await.unwrap().unwrap();
+    let first = store.claim(CAMPAIGN, "local", None).await.unwrap().unwrap();
     // Only the jobs asked for, if they are pending.
     let only = ["job-0000".to_string(), "job-0002".to_string()];
     let picked = store.claim_many(CAMPAIGN, Some(&only), 5, |k| format!("only_{k}")).await.unwrap();
@@ -88,7 +88,7 @@ async fn the_spec_of_a_job_not_done_can_be_replaced() {
     let jobs = store.jobs(CAMPAIGN).await.unwrap();
     assert_eq!((jobs[0].format, &jobs[0].spec), (2, &moved));
     assert_eq!((jobs[1].format, &jobs[1].spec), (1, &job(1).spec), "the other job is untouched");
-    let claimed = store.claim(CAMPAIGN, "w").await.unwrap().unwrap();
+    let claimed = store.claim(CAMPAIGN, "w", None).await.unwrap().unwrap();
     assert_eq!((claimed.format, claimed.spec), (2, moved.clone()));
     store.complete(&claimed.id, "w", &result(0.4), &[]).await.unwrap();
     assert!(!store.replace_spec("job-0000", 2, &json!({})).await.unwrap(), "a done job keeps its spec");

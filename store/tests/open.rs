@@ -74,7 +74,7 @@ async fn reopening_keeps_the_data() {
     let dir = tempfile::tempdir().unwrap();
     let path = db_path(&dir);
     let store = store_with_jobs(&path, 3).await;
-    let job = store.claim(CAMPAIGN, "w1").await.unwrap().unwrap();
+    let job = store.claim(CAMPAIGN, "w1", None).await.unwrap().unwrap();
     store.complete(&job.id, "w1", &result(0.37), &statistics(0.6)).await.unwrap();
     let before = store.export(CAMPAIGN).await.unwrap();
     store.close().await;

@@ -78,10 +78,10 @@ async fn child_process_killed() {
     let Some((path, worker_id, report)) = child_task() else { return };
     let store = Store::open(&path).await.unwrap();
     for _ in 0..3 {
-        let job = store.claim(CAMPAIGN, &worker_id).await.unwrap().unwrap();
+        let job = store.claim(CAMPAIGN, &worker_id, None).await.unwrap().unwrap();
         store.complete(&job.id, &worker_id, &result(0.36), &statistics(0.5)).await.unwrap();
     }
-    let job = store.claim(CAMPAIGN, &worker_id).await.unwrap().unwrap();
+    let job = store.claim(CAMPAIGN, &worker_id, None).await.unwrap().unwrap();
     store.save_checkpoint(&job.id, &worker_id, b"mid-packing", 4.0, None).await.unwrap();
     std::fs::write(report, "ready").unwrap();
     tokio::time::sleep(Duration::from_secs(600)).await;
@@ -119,11 +119,11 @@ fn a_killed_process_loses_no_finished_job() {
 
         // Resume: the dead worker's job goes back to the queue and continues from its checkpoint.
         assert_eq!(store.requeue_stale(CAMPAIGN, Duration::ZERO).await.unwrap(), ["job-0003"]);
-        let job = store.claim(CAMPAIGN, "heir").await.unwrap().unwrap();
+        let job = store.claim(CAMPAIGN, "heir", None).await.unwrap().unwrap();
         assert_eq!((job.id.as_str(), job.attempts), ("job-0003", 2));
         assert_eq!(store.load_checkpoint(&job.id).await.unwrap().unwrap().data, b"mid-packing");
         store.complete(&job.id, "heir", &result(0.37), &statistics(0.5)).await.unwrap();
-        let last = store.claim(CAMPAIGN, "heir").await.unwrap().unwrap();
+        let last = store.claim(CAMPAIGN, "heir", None).await.unwrap().unwrap();
         store.complete(&last.id, "heir", &result(0.38), &statistics(0.5)).await.unwrap();
 
         let rows = store.export(CAMPAIGN).await.unwrap();

@@ -40,7 +40,7 @@ async fn resubmitting_adds_nothing_and_a_superset_adds_only_the_new_jobs() {
     assert_eq!(store.status(CAMPAIGN).await.unwrap().jobs, 7);
 
     // A finished job stays finished when the campaign is submitted again.
-    let claimed = store.claim(CAMPAIGN, "w1").await.unwrap().unwrap();
+    let claimed = store.claim(CAMPAIGN, "w1", None).await.unwrap().unwrap();
     store.complete(&claimed.id, "w1", &result(0.4), &[]).await.unwrap();
     assert_eq!(store.add_jobs(CAMPAIGN, &jobs(0..7)).await.unwrap(), 0);
     assert_eq!(store.status(CAMPAIGN).await.unwrap().done, 1);
@@ -59,7 +59,7 @@ async fn claims_follow_submission_order_and_carry_the_job() {
     let dir = tempfile::tempdir().unwrap();
     let store = store_with_jobs(&db_path(&dir), 3).await;
     for index in 0..3 {
-        let claimed = store.claim(CAMPAIGN, "w1").await.unwrap().unwrap();
+        let claimed = store.claim(CAMPAIGN, "w1", None).await.unwrap().unwrap();
         let expected = job(index);
         assert_eq!(claimed.id, expected.id);
         assert_eq!((claimed.format, &claimed.spec), (expected.format, &expected.spec));
@@ -67,7 +67,7 @@ async fn claims_follow_submission_order_and_carry_the_job() {
         assert_eq!(claimed.parameters, expected.parameters);
         assert_eq!(claimed.attempts, 1);
     }
-    assert_eq!(store.claim(CAMPAIGN, "w1").await.unwrap(), None);
+    assert_eq!(store.claim(CAMPAIGN, "w1", None).await.unwrap(), None);
     let running = store.running_jobs(CAMPAIGN).await.unwrap();
     assert_eq!(running.len(), 3);
     assert!(running.iter().all(|job| job.worker_id == "w1" && job.heartbeat_at >= job.started_at));
@@ -75,15 +75,29 @@ async fn claims_follow_submission_order_and_carry_the_job() {
 }
 
 #[tokio::test]
+async fn a_claim_limited_to_some_jobs_takes_only_those_in_submission_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let store = store_with_jobs(&db_path(&dir), 5).await;
+    let only = [job(3).id, job(1).id];
+    let first = store.claim(CAMPAIGN, "w1", Some(&only)).await.unwrap().unwrap();
+    let second = store.claim(CAMPAIGN, "w1", Some(&only)).await.unwrap().unwrap();
+    assert_eq!((first.id, second.id), (job(1).id, job(3).id), "submission order, not the order asked");
+    assert_eq!(store.claim(CAMPAIGN, "w1", Some(&only)).await.unwrap(), None, "the others stay pending");
+    assert_eq!(store.status(CAMPAIGN).await.unwrap().pending, 3);
+    assert_eq!(store.claim(CAMPAIGN, "w1", None).await.unwrap().unwrap().id, job(0).id);
+    store.close().await;
+}
+
+#[tokio::test]
 async fn a_worker_that_lost_its_job_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let store = store_with_jobs(&db_path(&dir), 1).await;
-    let first = store.claim(CAMPAIGN, "w1").await.unwrap().unwrap();
+    let first = store.claim(CAMPAIGN, "w1", None).await.unwrap().unwrap();
     store.save_checkpoint(&first.id, "w1", b"w1 state", 1.0, None).await.unwrap();
 
     // The caller decided w1 is gone; w2 takes the job over from w1's checkpoint.
     assert!(store.release(&first.id, "w1").await.unwrap());
-    let second = store.claim(CAMPAIGN, "w2").await.unwrap().unwrap();
+    let second = store.claim(CAMPAIGN, "w2", None).await.unwrap().unwrap();
     assert_eq!((second.id.as_str(), second.attempts), (first.id.as_str(), 2));
 
     for outcome in [
@@ -121,8 +135,8 @@ async fn a_worker_that_lost_its_job_writes_nothing() {
 async fn stale_heartbeats_are_requeued_and_live_ones_kept() {
     let dir = tempfile::tempdir().unwrap();
     let store = store_with_jobs(&db_path(&dir), 3).await;
-    let dead = store.claim(CAMPAIGN, "dead").await.unwrap().unwrap();
-    let alive = store.claim(CAMPAIGN, "alive").await.unwrap().unwrap();
+    let dead = store.claim(CAMPAIGN, "dead", None).await.unwrap().unwrap();
+    let alive = store.claim(CAMPAIGN, "alive", None).await.unwrap().unwrap();
     tokio::time::sleep(Duration::from_millis(1200)).await;
     store.heartbeat(&alive.id, "alive").await.unwrap();
 
@@ -135,7 +149,7 @@ async fn stale_heartbeats_are_requeued_and_live_ones_kept() {
     let status = store.status(CAMPAIGN).await.unwrap();
     assert_eq!((status.pending, status.running), (2, 1));
     // The requeued job is first in line again, on its second attempt.
-    let again = store.claim(CAMPAIGN, "new").await.unwrap().unwrap();
+    let again = store.claim(CAMPAIGN, "new", None).await.unwrap().unwrap();
     assert_eq!((again.id, again.attempts), (dead.id, 2));
     assert!(store.requeue_stale(CAMPAIGN, Duration::from_secs(60)).await.unwrap().is_empty());
     store.close().await;
@@ -145,7 +159,7 @@ async fn stale_heartbeats_are_requeued_and_live_ones_kept() {
 async fn released_jobs_return_to_pending_with_their_checkpoint() {
     let dir = tempfile::tempdir().unwrap();
     let store = store_with_jobs(&db_path(&dir), 2).await;
-    let claimed = store.claim(CAMPAIGN, "w1").await.unwrap().unwrap();
+    let claimed = store.claim(CAMPAIGN, "w1", None).await.unwrap().unwrap();
     store.save_checkpoint(&claimed.id, "w1", b"half way", 3.0, None).await.unwrap();
     assert!(!store.release(&claimed.id, "someone else").await.unwrap());
     assert!(store.release(&claimed.id, "w1").await.unwrap());
@@ -156,7 +170,7 @@ async fn released_jobs_return_to_pending_with_their_checkpoint() {
     assert!(store.running_jobs(CAMPAIGN).await.unwrap().is_empty());
     let checkpoint = store.load_checkpoint(&claimed.id).await.unwrap().unwrap();
     assert_eq!((checkpoint.data.as_slice(), checkpoint.simulated_time), (&b"half way"[..], 3.0));
-    let again = store.claim(CAMPAIGN, "w2").await.unwrap().unwrap();
+    let again = store.claim(CAMPAIGN, "w2", None).await.unwrap().unwrap();
     assert_eq!((again.id, again.attempts), (claimed.id, 2));
     store.close().await;
 }
@@ -165,9 +179,9 @@ async fn released_jobs_return_to_pending_with_their_checkpoint() {
 async fn status_says_how_far_running_and_interrupted_jobs_are() {
     let dir = tempfile::tempdir().unwrap();
     let store = store_with_jobs(&db_path(&dir), 4).await;
-    let a = store.claim(CAMPAIGN, "w1").await.unwrap().unwrap();
-    let b = store.claim(CAMPAIGN, "w2").await.unwrap().unwrap();
-    let c = store.claim(CAMPAIGN, "w3").await.unwrap().unwrap();
+    let a = store.claim(CAMPAIGN, "w1", None).await.unwrap().unwrap();
+    let b = store.claim(CAMPAIGN, "w2", None).await.unwrap().unwrap();
+    let c = store.claim(CAMPAIGN, "w3", None).await.unwrap().unwrap();
     let stage = Stage { phase: "generation".into(), grains: 1972, mass_created: 0.382, shaking_until: None };
     let shaking = Stage { phase: "shaking".into(), grains: 5100, mass_created: 1.0, shaking_until: Some(6.25) };
     store.save_checkpoint(&a.id, "w1", b"a", 1.5, Some(&stage)).await.unwrap();
@@ -208,7 +222,7 @@ async fn status_says_how_far_running_and_interrupted_jobs_are() {
 async fn failed_jobs_keep_their_error_until_retried() {
     let dir = tempfile::tempdir().unwrap();
     let store = store_with_jobs(&db_path(&dir), 2).await;
-    let claimed = store.claim(CAMPAIGN, "w1").await.unwrap().unwrap();
+    let claimed = store.claim(CAMPAIGN, "w1", None).await.unwrap().unwrap();
     store.save_checkpoint(&claimed.id, "w1", b"before the crash", 1.0, None).await.unwrap();
     store.fail(&claimed.id, "w1", "no packing surface found").await.unwrap();
     assert!(matches!(store.fail(&claimed.id, "w1", "again").await, Err(StoreError::NotOwner { .. })));
@@ -229,7 +243,7 @@ async fn failed_jobs_keep_their_error_until_retried() {
     assert_eq!((status.pending, status.failed, status.failures.len()), (2, 0, 0));
     let row = &store.export(CAMPAIGN).await.unwrap()[0];
     assert_eq!((row.state, &row.error), (JobState::Pending, &None));
-    let again = store.claim(CAMPAIGN, "w2").await.unwrap().unwrap();
+    let again = store.claim(CAMPAIGN, "w2", None).await.unwrap().unwrap();
     assert_eq!((again.id, again.attempts), (claimed.id, 2));
     store.close().await;
 }
@@ -241,10 +255,10 @@ async fn status_counts_states_and_times_finished_jobs() {
     let empty = store.status(CAMPAIGN).await.unwrap();
     assert_eq!((empty.jobs, empty.pending, empty.wall_time_finished, empty.mean_wall_time_done), (5, 5, 0.0, None));
 
-    let done_a = store.claim(CAMPAIGN, "w1").await.unwrap().unwrap();
-    let done_b = store.claim(CAMPAIGN, "w2").await.unwrap().unwrap();
-    let failed = store.claim(CAMPAIGN, "w3").await.unwrap().unwrap();
-    let _running = store.claim(CAMPAIGN, "w4").await.unwrap().unwrap();
+    let done_a = store.claim(CAMPAIGN, "w1", None).await.unwrap().unwrap();
+    let done_b = store.claim(CAMPAIGN, "w2", None).await.unwrap().unwrap();
+    let failed = store.claim(CAMPAIGN, "w3", None).await.unwrap().unwrap();
+    let _running = store.claim(CAMPAIGN, "w4", None).await.unwrap().unwrap();
     tokio::time::sleep(Duration::from_millis(300)).await;
     store.complete(&done_a.id, "w1", &result(0.37), &[]).await.unwrap();
     store.complete(&done_b.id, "w2", &JobResult { simulated_time: 8.5, ..result(0.39) }, &[]).await.unwrap();
@@ -273,8 +287,8 @@ async fn export_gives_every_job_with_its_result_and_statistics() {
     let store = store_with_jobs(&db_path(&dir), 3).await;
     store.upsert_campaign("other", "").await.unwrap();
     store.add_jobs("other", &[job(50)]).await.unwrap();
-    let first = store.claim(CAMPAIGN, "w1").await.unwrap().unwrap();
-    let second = store.claim(CAMPAIGN, "w1").await.unwrap().unwrap();
+    let first = store.claim(CAMPAIGN, "w1", None).await.unwrap().unwrap();
+    let second = store.claim(CAMPAIGN, "w1", None).await.unwrap().unwrap();
     let imbricated = JobResult { imbrication: Some(json!({"mean_dip": 21.5, "upstream": 0.6})), ..result(0.371) };
     store.complete(&first.id, "w1", &imbricated, &statistics(0.647)).await.unwrap();
     store.fail(&second.id, "w1", "solver diverged").await.unwrap();
@@ -314,7 +328,7 @@ async fn export_gives_every_job_with_its_result_and_statistics() {
 async fn checkpoints_round_trip_and_are_overwritten() {
     let dir = tempfile::tempdir().unwrap();
     let store = store_with_jobs(&db_path(&dir), 1).await;
-    let claimed = store.claim(CAMPAIGN, "w1").await.unwrap().unwrap();
+    let claimed = store.claim(CAMPAIGN, "w1", None).await.unwrap().unwrap();
     assert_eq!(store.load_checkpoint(&claimed.id).await.unwrap(), None);
 
     let first: Vec<u8> = (0..=255).cycle().take(100_000).collect();

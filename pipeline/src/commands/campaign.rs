@@ -20,6 +20,7 @@ use crate::executor::{Executor, Request};
 use crate::output::{Table, phase_words, print_json};
 use crate::records::new_job;
 use crate::runner::{self, OldCheckpoint, RunOptions, Summary, old_format, refuse_old_checkpoints};
+use crate::selection::Selection;
 use crate::slurm::{self, Followed, RunDir, Submission, TaskRow};
 use crate::{outln, stored};
 
@@ -103,6 +104,12 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     .checked_flags()?;
     let interval = checkpoint_interval(args.common.checkpoint_interval)?;
     let campaign = read_campaign(&args.campaign)?;
+    if let Some(selection) = Selection::parse(&args.common.only)? {
+        // Refused before anything is stored.
+        let planned: Vec<(String, Map<String, Value>)> =
+            campaign.jobs.iter().map(|j| (j.id.clone(), j.parameters.clone())).collect();
+        selection.pick(&campaign.name, &planned)?;
+    }
     let thin: Vec<String> = campaign.jobs.iter().filter_map(|j| j.spec.thin_bed()).collect();
     if let Some(first) = thin.first() {
         let more = if thin.len() > 1 { format!(" (and {} more job(s) alike)", thin.len() - 1) } else { String::new() };
@@ -230,17 +237,21 @@ async fn continue_campaign(
         Executor::Local => {
             let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
             let (workers, threads) = local_threads(local, cores)?;
+            retry_failed(store, name, common.retry_failed).await?;
+            let only = selected(store, name, &common.only).await?;
             let options = RunOptions {
                 workers,
                 threads,
                 checkpoint_interval,
                 discard_old_checkpoints: common.discard_old_checkpoints,
+                only: only.clone(),
             };
-            retry_failed(store, name, common.retry_failed).await?;
             if !common.discard_old_checkpoints {
                 // All at once before anything starts; the workers check jobs requeued later.
                 runner::recover(store, name).await?;
-                refuse_old_checkpoints(name, &runner::old_checkpoints(store, name).await?)?;
+                let mut old = runner::old_checkpoints(store, name).await?;
+                old.retain(|c| only.as_ref().is_none_or(|ids| ids.contains(&c.job)));
+                refuse_old_checkpoints(name, &old)?;
             }
             let summary = runner::run(store, name, &options, !common.quiet).await?;
             return report(name, summary, &store.status(name).await?).map_err(Into::into);
@@ -249,10 +260,13 @@ async fn continue_campaign(
     let run = RunDir::of(db, name)?;
     slurm::sync(store, &run, name).await?;
     retry_failed(store, name, common.retry_failed).await?;
+    let only = selected(store, name, &common.only).await?;
+    let only = only.as_deref();
     if !common.discard_old_checkpoints {
         // The tasks run this binary and continue from the checkpoints in the run directory.
         let mut old = Vec::new();
-        for job in store.jobs(name).await?.into_iter().filter(|j| j.state == JobState::Pending) {
+        let jobs = store.jobs(name).await?.into_iter().filter(|j| j.state == JobState::Pending);
+        for job in jobs.filter(|j| only.is_none_or(|ids| ids.contains(&j.id))) {
             if let Some(format) = std::fs::read(run.job(&job.id).checkpoint()).ok().and_then(|d| old_format(&d)) {
                 old.push(OldCheckpoint { job: job.id, format, simulated_time: None });
             }
@@ -260,7 +274,7 @@ async fn continue_campaign(
         refuse_old_checkpoints(name, &old)?;
     }
     let submission = Submission { store, run: &run, campaign: name, settings, checkpoint_interval };
-    let arrays = submission.pending(None).await?;
+    let arrays = submission.pending(only).await?;
     for a in &arrays {
         outln!("{name}: submitted Slurm array {} ({} job(s))", a.array, a.jobs)?;
     }
@@ -281,6 +295,20 @@ async fn continue_campaign(
         _ => {}
     }
     Ok(())
+}
+
+/// The jobs `--only` picks (None without it), and a line saying how many.
+async fn selected(store: &Store, name: &str, only: &[String]) -> anyhow::Result<Option<Vec<String>>> {
+    let Some(selection) = Selection::parse(only)? else {
+        return Ok(None);
+    };
+    let rows = store.export(name).await?;
+    let jobs: Vec<(String, Map<String, Value>)> =
+        rows.iter().map(|r| (r.job_id.clone(), r.parameters.clone())).collect();
+    let ids = selection.pick(name, &jobs)?;
+    let pending = rows.iter().filter(|r| r.state == JobState::Pending && ids.contains(&r.job_id)).count();
+    outln!("{name}: --only picks {} job(s), {pending} of them pending; the others are left as they are", ids.len())?;
+    Ok(Some(ids))
 }
 
 async fn retry_failed(store: &Store, name: &str, retry: bool) -> anyhow::Result<()> {

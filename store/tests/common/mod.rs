@@ -72,7 +72,7 @@ pub async fn store_with_jobs(path: &Path, count: usize) -> Store {
 /// Claims and completes jobs until none is pending; returns the ids it completed.
 pub async fn work(store: Store, worker_id: String) -> Vec<String> {
     let mut completed = Vec::new();
-    while let Some(job) = store.claim(CAMPAIGN, &worker_id).await.unwrap() {
+    while let Some(job) = store.claim(CAMPAIGN, &worker_id, None).await.unwrap() {
         assert_eq!(job.attempts, 1, "{} was claimed before", job.id);
         store.complete(&job.id, &worker_id, &result(0.4), &statistics(0.6)).await.unwrap();
         completed.push(job.id);
