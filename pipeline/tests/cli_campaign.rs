@@ -92,6 +92,7 @@ fn only_runs_the_jobs_of_the_grid_values_asked_for_and_leaves_the_others_pending
         first.contains("--only picks 2 job(s), 2 of them pending") && first.contains("2 job(s) finished now"),
         "{first}"
     );
+    assert!(first.contains("2 job(s) that --only left out are pending: `sedpack resume only` runs them"), "{first}");
     let by_state = |state: JobState| -> Vec<(f64, u64)> {
         let mut out: Vec<(f64, u64)> = rows(db, "only")
             .iter()
@@ -160,7 +161,7 @@ fn ctrl_c_checkpoints_running_jobs_and_returns_them_to_pending() {
     let file = write(dir.path(), "stop.yaml", &campaign("stop", 0.6));
     let db = &path_in(dir.path(), "stop.db");
     let child = Command::new(env!("CARGO_BIN_EXE_sedpack"))
-        .args(["run", &file, "--db", db, "--workers", "1", "--quiet"])
+        .args(["run", &file, "--db", db, "--workers", "1", "--quiet", "--only", "seed=1"])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -178,7 +179,11 @@ fn ctrl_c_checkpoints_running_jobs_and_returns_them_to_pending() {
     let out = child.wait_with_output().unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    assert!(stdout.contains("interrupted") && stdout.contains("sedpack resume stop"), "{stdout}");
+    // The command it gives continues what was asked: the jobs of seed 1.
+    assert!(
+        stdout.contains("interrupted: run `sedpack resume stop --only seed=1` to finish the jobs --only picks"),
+        "{stdout}"
+    );
     let rows = rows(db, "stop");
     assert!(rows.iter().all(|r| r.state != JobState::Running), "no job left running");
     assert!(rows.iter().any(|r| r.state == JobState::Pending), "the interrupted job is pending again");

@@ -75,13 +75,29 @@ fn print_states(head: &str, status: &CampaignStatus, running: &str) -> std::io::
     Ok(())
 }
 
-fn report(name: &str, summary: Summary, status: &CampaignStatus) -> std::io::Result<()> {
+/// What a local run did; `only` is its `--only` arguments, repeated in the command that
+/// continues it.
+fn report(name: &str, summary: Summary, status: &CampaignStatus, only: &[String]) -> std::io::Result<()> {
     let head = format!("{name}: {} job(s) finished now, {} failed now; campaign: ", summary.completed, summary.failed);
     print_states(&head, status, "running")?;
+    let picked: String = only.iter().map(|a| format!(" --only {}", shell_word(a))).collect();
     if summary.interrupted {
-        outln!("interrupted: run `sedpack resume {name}` to finish the campaign")?;
+        let what = if only.is_empty() { "the campaign" } else { "the jobs --only picks" };
+        outln!("interrupted: run `sedpack resume {name}{picked}` to finish {what}")?;
+    } else if !only.is_empty() && status.pending > 0 {
+        outln!("{} job(s) that --only left out are pending: `sedpack resume {name}` runs them", status.pending)?;
     }
     Ok(())
+}
+
+/// An argument as a POSIX shell reads it back: quoted unless it is plain.
+fn shell_word(arg: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "._=-+,/:".contains(c);
+    if !arg.is_empty() && arg.chars().all(plain) {
+        arg.to_string()
+    } else {
+        format!("'{}'", arg.replace('\'', "'\\''"))
+    }
 }
 
 /// `--checkpoint-interval` as a duration: a positive, finite number of seconds.
@@ -254,7 +270,7 @@ async fn continue_campaign(
                 refuse_old_checkpoints(name, &old)?;
             }
             let summary = runner::run(store, name, &options, !common.quiet).await?;
-            return report(name, summary, &store.status(name).await?).map_err(Into::into);
+            return report(name, summary, &store.status(name).await?, &common.only).map_err(Into::into);
         }
     };
     let run = RunDir::of(db, name)?;
@@ -690,6 +706,13 @@ mod tests {
     use store::Stage;
 
     use super::*;
+
+    #[test]
+    fn arguments_are_quoted_for_the_shell_unless_plain() {
+        assert_eq!(shell_word("grains.size=B50"), "grains.size=B50");
+        assert_eq!(shell_word("name=a b"), "'name=a b'");
+        assert_eq!(shell_word("k=it's"), r"'k=it'\''s'");
+    }
 
     #[test]
     fn grid_values_become_csv_fields() {
