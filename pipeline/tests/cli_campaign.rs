@@ -41,6 +41,34 @@ fn a_grid_campaign_runs_once_and_reports() {
         (Some(4), Some(4), Some(0))
     );
     let before = porosities(db, "grid");
+    // The status gives each setup's porosities (friction 0.0 first, as submitted) and their mean
+    // and population std, recomputed here from the stored results.
+    let results = status["results"].as_array().unwrap();
+    assert_eq!(results.len(), 2, "{results:?}");
+    for (result, friction) in results.iter().zip([0.0, 0.5]) {
+        assert_eq!(result["setup"], format!("material.friction = {friction:?}"));
+        let mut stored: Vec<f64> = rows(db, "grid")
+            .iter()
+            .filter(|r| r.parameters["material.friction"].as_f64() == Some(friction))
+            .map(|r| r.result.as_ref().unwrap().porosity)
+            .collect();
+        let mut shown: Vec<f64> =
+            result["porosities"].as_array().unwrap().iter().map(|n| n.as_f64().unwrap()).collect();
+        stored.sort_by(f64::total_cmp);
+        shown.sort_by(f64::total_cmp);
+        assert_eq!(shown, stored);
+        let mean = (stored[0] + stored[1]) / 2.0;
+        let std = (stored[1] - stored[0]).abs() / 2.0;
+        assert!((result["mean"].as_f64().unwrap() - mean).abs() < 1e-15, "{result}");
+        assert!((result["std"].as_f64().unwrap() - std).abs() < 1e-15, "{result}");
+    }
+    let text = ok(&["status", "grid", "--db", db]);
+    let line = text.lines().find(|l| l.starts_with("porosity")).unwrap_or_else(|| panic!("{text}"));
+    assert!(
+        line.contains("material.friction = 0.0: ")
+            && line.contains(&format!("(mean {:.3} ± ", results[0]["mean"].as_f64().unwrap())),
+        "{text}"
+    );
 
     // Submitting the same campaign again adds no job and runs nothing.
     let again = ok(&["run", &file, "--db", db, "--quiet"]);

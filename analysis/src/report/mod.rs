@@ -328,9 +328,14 @@ fn cost_cells(cost: &Cost) -> [String; 3] {
 
 /// A packing's setup: its parameters apart from the seed.
 fn setup_label(r: &JobRecord) -> String {
-    let setup: Vec<String> = r
-        .parameters
-        .iter()
+    setup_text(&r.parameters)
+}
+
+/// A setup in words, from a job's grid values: every one but the seed ("grains.size = U3"), or
+/// "all jobs" when the seed is the only one.
+pub fn setup_text<'a>(parameters: impl IntoIterator<Item = (&'a String, &'a Value)>) -> String {
+    let setup: Vec<String> = parameters
+        .into_iter()
         .filter(|(k, _)| k.as_str() != "seed")
         .map(|(k, v)| format!("{k} = {}", value_text(v)))
         .collect();
@@ -545,8 +550,8 @@ fn counted(n: usize, noun: &str) -> String {
     format!("{n} {noun}{}", if n == 1 { "" } else { "s" })
 }
 
-/// Mean and population standard deviation.
-fn mean_std(values: &[f64]) -> (f64, f64) {
+/// Mean and population standard deviation: the ± of the report's setups.
+pub fn mean_std(values: &[f64]) -> (f64, f64) {
     let mean = values.iter().sum::<f64>() / values.len() as f64;
     (mean, (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / values.len() as f64).sqrt())
 }

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use analysis::csv;
-use analysis::report::duration;
+use analysis::report::{duration, mean_std, setup_text};
 use anyhow::{Context, bail};
 use serde::Serialize;
 use serde_json::{Map, Value};
@@ -396,6 +396,8 @@ struct StatusRecord {
     jobs_not_estimated: usize,
     #[serde(skip)]
     time_left: Option<TimeLeft>,
+    /// The porosities of the done jobs, per setup.
+    results: Vec<SetupResults>,
     executor: Executor,
     /// A Slurm campaign's jobs beside their tasks' states in Slurm.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -407,9 +409,8 @@ async fn status_record(store: &Store, db: &Path, name: &str) -> anyhow::Result<S
     let status = store.status(name).await?;
     let checkpoints: HashMap<&str, f64> =
         status.in_progress.iter().filter_map(|p| Some((p.job_id.as_str(), p.checkpoint?.0))).collect();
-    let jobs: Vec<Weighed> = store
-        .export(name)
-        .await?
+    let rows = store.export(name).await?;
+    let jobs: Vec<Weighed> = rows
         .iter()
         .map(|row| Weighed {
             setup: setup_key(&row.parameters),
@@ -428,9 +429,52 @@ async fn status_record(store: &Store, db: &Path, name: &str) -> anyhow::Result<S
         estimated_time_left: time_left.as_ref().map(|t| t.seconds),
         jobs_not_estimated: time_left.as_ref().map_or(0, |t| t.unestimated),
         time_left,
+        results: SetupResults::of(&rows),
         executor,
         tasks,
     })
+}
+
+/// The porosities of one setup's done jobs (in submission order), with their mean and
+/// population standard deviation, as the report's tables give them.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+struct SetupResults {
+    setup: String,
+    porosities: Vec<f64>,
+    mean: f64,
+    std: f64,
+}
+
+impl SetupResults {
+    /// One entry per setup with a done job, in the order the setups were submitted.
+    fn of(rows: &[ExportRow]) -> Vec<Self> {
+        let mut setups: Vec<(String, Vec<f64>)> = Vec::new();
+        for row in rows.iter().filter(|r| r.state == JobState::Done) {
+            let Some(result) = &row.result else { continue };
+            let setup = setup_text(&row.parameters);
+            match setups.iter_mut().find(|(s, _)| *s == setup) {
+                Some((_, porosities)) => porosities.push(result.porosity),
+                None => setups.push((setup, vec![result.porosity])),
+            }
+        }
+        setups
+            .into_iter()
+            .map(|(setup, porosities)| {
+                let (mean, std) = mean_std(&porosities);
+                Self { setup, porosities, mean, std }
+            })
+            .collect()
+    }
+
+    /// "grains.size = U3: 0.391, 0.388 (mean 0.389 ± 0.002)".
+    fn text(&self) -> String {
+        let runs: Vec<String> = self.porosities.iter().map(|n| format!("{n:.3}")).collect();
+        let mean = match self.porosities.len() {
+            1 => String::new(),
+            _ => format!(" (mean {:.3} ± {:.3})", self.mean, self.std),
+        };
+        format!("{}: {}{mean}", self.setup, runs.join(", "))
+    }
 }
 
 /// A job's setup: its grid values but the seed.
@@ -569,6 +613,9 @@ pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
                 .row("time spent", format!("{} on finished jobs", duration(s.wall_time_finished)));
             if let Some(t) = &r.time_left {
                 table.row("time left", t.text());
+            }
+            for (k, results) in r.results.iter().enumerate() {
+                table.row(if k == 0 { "porosity" } else { "" }, results.text());
             }
             for f in &s.failures {
                 table.row(format!("failed {}", f.job_id), f.error.clone());
