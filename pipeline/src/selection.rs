@@ -3,6 +3,7 @@
 
 use std::collections::BTreeMap;
 
+use analysis::report::value_text;
 use anyhow::bail;
 use serde_json::{Map, Value};
 
@@ -34,7 +35,7 @@ impl Selection {
     /// job has, or a value no job has for its key, is an error naming what the jobs have.
     pub fn pick(&self, campaign: &str, jobs: &[(String, Map<String, Value>)]) -> anyhow::Result<Vec<String>> {
         for (key, values) in &self.wanted {
-            let mut known: Vec<String> = jobs.iter().filter_map(|(_, p)| p.get(key)).map(text).collect();
+            let mut known: Vec<String> = jobs.iter().filter_map(|(_, p)| p.get(key)).map(value_text).collect();
             if known.is_empty() {
                 let mut keys: Vec<&str> = jobs.iter().flat_map(|(_, p)| p.keys()).map(String::as_str).collect();
                 keys.sort_unstable();
@@ -60,17 +61,9 @@ impl Selection {
     }
 }
 
-/// A grid value as the user writes it: a string without its quotes, anything else as JSON.
-fn text(value: &Value) -> String {
-    match value {
-        Value::String(s) => s.clone(),
-        other => other.to_string(),
-    }
-}
-
 /// Whether a grid value is the one written, numbers compared as numbers (`0.5` is `0.50`).
 fn same(value: &Value, written: &str) -> bool {
-    if text(value) == written {
+    if value_text(value) == written {
         return true;
     }
     match (value.as_f64(), written.parse::<f64>()) {

@@ -151,7 +151,8 @@ pub fn duration(seconds: f64) -> String {
     }
 }
 
-fn value_text(v: &Value) -> String {
+/// A grid value as a user writes it: a string without its quotes, anything else as JSON.
+pub fn value_text(v: &Value) -> String {
     match v {
         Value::String(s) => s.clone(),
         other => other.to_string(),
