@@ -413,7 +413,7 @@ async fn status_record(store: &Store, db: &Path, name: &str) -> anyhow::Result<S
     let jobs: Vec<Weighed> = rows
         .iter()
         .map(|row| Weighed {
-            setup: setup_key(&row.parameters),
+            setup: setup_text(&row.parameters),
             ended: matches!(row.state, JobState::Done | JobState::Failed),
             done: row.result.as_ref().filter(|_| row.state == JobState::Done).map(|r| (r.wall_time, r.simulated_time)),
             checkpoint: checkpoints.get(row.job_id.as_str()).copied(),
@@ -475,13 +475,6 @@ impl SetupResults {
         };
         format!("{}: {}{mean}", self.setup, runs.join(", "))
     }
-}
-
-/// A job's setup: its grid values but the seed.
-fn setup_key(parameters: &Map<String, Value>) -> String {
-    let setup: Map<String, Value> =
-        parameters.iter().filter(|(k, _)| k.as_str() != "seed").map(|(k, v)| (k.clone(), v.clone())).collect();
-    Value::Object(setup).to_string()
 }
 
 /// One job as the time left weighs it: its setup, whether it has ended, a done job's wall and
@@ -866,7 +859,7 @@ mod tests {
             "not estimated: none of the 2 job(s) left shares its setup with a done job"
         );
         // The setup is the grid values but the seed.
-        let key = |json: &str| setup_key(serde_json::from_str::<Value>(json).unwrap().as_object().unwrap());
+        let key = |json: &str| setup_text(serde_json::from_str::<Value>(json).unwrap().as_object().unwrap());
         assert_eq!(key(r#"{"seed":1,"grains.size":"U3"}"#), key(r#"{"grains.size":"U3","seed":2}"#));
         assert_ne!(key(r#"{"seed":1,"grains.size":"U3"}"#), key(r#"{"seed":1,"grains.size":"U5"}"#));
     }
