@@ -192,8 +192,9 @@ const SIMULATED: [Simulated; 32] = [
 /// (`PackingSpec::paper`), the grid spacing and trim of its rules included. Only the seed, the
 /// domain height, the time limit, the meshes, the contact point of polyhedra (sedpack's
 /// centre of pressure or the paper's software's witness), the calibration of k_n and d_n
-/// (sedpack's discrete one or Eq. 11 as printed) and the orientation of new grains (sedpack's
-/// random turns or the paper's software's upright grains) may differ.
+/// (sedpack's discrete one or Eq. 11 as printed), the orientation of new grains (sedpack's
+/// random turns or the paper's software's upright grains) and their grid (the text's cubic one
+/// or the software's close-packed one) may differ.
 pub fn simulated_porosity(spec: &PackingSpec) -> Option<PaperPorosity> {
     let case = spec.grains.size.case()?.name;
     let row = SIMULATED.iter().find(|s| row_differences(s, spec, case).is_empty())?;
@@ -236,7 +237,7 @@ fn row_differences(row: &Simulated, spec: &PackingSpec, case: &str) -> Vec<Strin
 /// Whether `spec` is the paper's protocol (`PackingSpec::paper` of its domain's kind) for meshes
 /// of `form`, of its own domain, sieve curve, mass and shaking duration, with no fluid forces;
 /// the seed, the domain height, the time limit, the meshes, the contact point of polyhedra, the
-/// calibration and the orientation of new grains may differ, and the grid spacing and trim are compared as the paper's rules
+/// calibration, the orientation of new grains and their grid may differ, and the grid spacing and trim are compared as the paper's rules
 /// work them out.
 fn follows_papers_protocol(spec: &PackingSpec, form: FormSpec) -> bool {
     let (papers, rules) = papers_protocol(spec, form);
@@ -265,6 +266,8 @@ fn papers_protocol(spec: &PackingSpec, form: FormSpec) -> (PackingSpec, Derived)
     papers.calibration = spec.calibration;
     // §4.3 does not say how new grains lie; its software creates them upright.
     papers.process.orientation = spec.process.orientation;
+    // §4.3's grid is "hexahedral"; its software's is close-packed.
+    papers.process.grid = spec.process.grid;
     // A stored job names the spacing and trim that the paper's rules give (the stored form is
     // concrete): compared as worked out, not as written.
     let rules = papers.derived();
@@ -498,10 +501,12 @@ mod tests {
         spec.contact_point = solver::dem::ContactPoint::Witness;
         assert_eq!(found(&spec).map(|f| f.1), Some(0.291));
         // So is Eq. 11 as the paper prints it, which its software uses, and its software's
-        // upright new grains.
+        // upright new grains and close-packed grid.
         spec.calibration = solver::dem::Calibration::Continuous;
         assert_eq!(found(&spec).map(|f| f.1), Some(0.291));
         spec.process.orientation = solver::packing::Orientation::Upright;
+        assert_eq!(found(&spec).map(|f| f.1), Some(0.291));
+        spec.process.grid = solver::packing::Grid::Hcp;
         assert_eq!(found(&spec).map(|f| f.1), Some(0.291));
     }
 

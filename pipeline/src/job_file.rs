@@ -171,6 +171,7 @@ pub struct GenerationFile {
     pub spacing: Option<Auto>,
     pub velocity: Option<f64>,
     pub orientation: Option<OrientationFile>,
+    pub grid: Option<GridFile>,
 }
 
 /// How a new grain lies.
@@ -181,6 +182,16 @@ pub enum OrientationFile {
     Random,
     /// Long axis vertical, short axis along x, every grain alike: the paper's software.
     Upright,
+}
+
+/// The grid new grains are created on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GridFile {
+    /// Cubic, centred (default): the text's hexahedral grid.
+    Cubic,
+    /// Hexagonal close-packed from the domain's axis: the paper's software.
+    Hcp,
 }
 
 #[derive(Debug, Default, Deserialize)]

@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 use solver::dem::{Calibration, ContactPoint, Domain};
 use solver::fabric::Imbrication;
 use solver::fluid::flow::Flow;
-use solver::packing::{FormSpec, Orientation, PackingResult, PackingSpec, ShapeKind};
+use solver::packing::{FormSpec, Grid, Orientation, PackingResult, PackingSpec, ShapeKind};
 use solver::porosity::ProfilePoint;
 use store::{CampaignStatus, ExportRow, GrainStatistic, JobResult, NewJob};
 
@@ -160,6 +160,9 @@ fn setup(spec: &PackingSpec) -> Vec<(String, String)> {
     if spec.process.orientation == Orientation::Upright {
         items.push(("new grains", "upright, long axis vertical (the paper's software)".to_string()));
     }
+    if spec.process.grid == Grid::Hcp {
+        items.push(("generation grid", "hexagonal close-packed (the paper's software)".to_string()));
+    }
     items.push((
         "fluid forces",
         FluidColumn::of(spec).map_or_else(|| "none (buoyancy only)".to_string(), |f| f.describe()),
@@ -283,13 +286,16 @@ mod tests {
         assert_eq!(item(&items, "porosity trim T"), Some("0 m"));
         cylinder.contact_point = ContactPoint::CentreOfPressure;
         assert_eq!(item(&setup(&cylinder), "contact point"), Some("centre of pressure of the overlap"));
-        // The paper's software's Eq. 11 and upright grains are named; sedpack's defaults are not.
+        // The paper's software's Eq. 11, upright grains and grid are named; sedpack's defaults are not.
         assert_eq!((item(&items, "k_n and d_n"), item(&items, "new grains")), (None, None));
+        assert_eq!(item(&items, "generation grid"), None);
         cylinder.calibration = Calibration::Continuous;
         cylinder.process.orientation = Orientation::Upright;
+        cylinder.process.grid = Grid::Hcp;
         let items = setup(&cylinder);
         assert_eq!(item(&items, "k_n and d_n"), Some("Eq. 11 as printed (the paper's software)"));
         assert_eq!(item(&items, "new grains"), Some("upright, long axis vertical (the paper's software)"));
+        assert_eq!(item(&items, "generation grid"), Some("hexagonal close-packed (the paper's software)"));
 
         // §6: 16 kg in 0.2 m × 0.2 m reach 16/(2650 · 0.04 · 0.6) = 0.2516 m; a 4–8 mm curve
         // without a case spaces the grid by its largest grain, H = ⌈(0.2516 + 0.016)/0.6⌉ =

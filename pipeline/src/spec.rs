@@ -11,12 +11,12 @@ use solver::fluid::flow::Flow;
 use solver::grain::simplify::DEFAULT_MAX_FACES;
 use solver::grain::{FormDistribution, SieveCurve, Table3Case};
 use solver::packing::{
-    DomainKind, FluidSpec, FormSpec, Orientation, PackingSpec, Process, ShapeKind, SpecError, in_range,
+    DomainKind, FluidSpec, FormSpec, Grid, Orientation, PackingSpec, Process, ShapeKind, SpecError, in_range,
 };
 
 use crate::job_file::{
     CalibrationFile, ContactPointFile, DomainFile, DomainKindFile, EvaluationFile, ExperimentFile, FlowFile,
-    FlowKindFile, FluidFile, FormFile, GrainsFile, JobFile, MaterialFile, OrientationFile, ProcessFile,
+    FlowKindFile, FluidFile, FormFile, GrainsFile, GridFile, JobFile, MaterialFile, OrientationFile, ProcessFile,
     ProcessFluidFile, ShapeFile, SizeFile, SolverFile, Source, read_job_file,
 };
 use crate::meshes;
@@ -191,6 +191,13 @@ fn process(p: ProcessFile, process: &mut Process) {
         generation.orientation.map(|o| match o {
             OrientationFile::Random => Orientation::Random,
             OrientationFile::Upright => Orientation::Upright,
+        }),
+    );
+    set(
+        &mut process.grid,
+        generation.grid.map(|g| match g {
+            GridFile::Cubic => Grid::Cubic,
+            GridFile::Hcp => Grid::Hcp,
         }),
     );
     let shaking = p.shaking.unwrap_or_default();

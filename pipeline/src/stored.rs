@@ -22,6 +22,10 @@
 //!   (`packing.process.orientation`, as the paper's software does), which formats 1 to 4 have
 //!   not: a job of randomly turned grains is written as before, and a version that knows only
 //!   formats 1 to 4 refuses a job of upright grains instead of turning them at random.
+//! - Format 6 is format 2 to 5 whose identity creates new grains on the close-packed grid of the
+//!   paper's software (`packing.process.grid`), which formats 1 to 5 have not: a job on the cubic
+//!   grid is written as before, and a version that knows only formats 1 to 5 refuses a job on
+//!   the close-packed grid instead of raining it from the cubic one.
 //!
 //! A stored format is frozen: a release that adds a field writes a new format with its own types
 //! beside these, keeps reading every older one (giving the new field the value that reproduces
@@ -33,28 +37,34 @@ use sha2::{Digest, Sha256};
 use solver::dem::{Calibration, ContactPoint, Domain, Material, Shaking};
 use solver::fluid::flow::Flow;
 use solver::grain::{FormDistribution, MeshLibrary, SieveCurve, Table3Case};
-use solver::packing::{FluidSpec, FormSpec, GrainSpec, Orientation, PackingSpec, Process, ShapeKind};
+use solver::packing::{FluidSpec, FormSpec, GrainSpec, Grid, Orientation, PackingSpec, Process, ShapeKind};
 
 use crate::meshes;
 use crate::spec::JobSpec;
 
 /// The newest format this version reads and writes.
-pub const FORMAT: u32 = 5;
+pub const FORMAT: u32 = 6;
 
 /// The format a job is written in: the oldest of this version's that holds it.
 pub fn format(job: &JobSpec) -> u32 {
     let p = &job.packing;
-    needed(p.process.orientation == Orientation::Upright, p.contact_point == ContactPoint::Witness, p.fluid.is_some())
+    needed(
+        p.process.grid == Grid::Hcp,
+        p.process.orientation == Orientation::Upright,
+        p.contact_point == ContactPoint::Witness,
+        p.fluid.is_some(),
+    )
 }
 
-/// The oldest format with upright grains, a witness contact point and fluid forces if these
-/// are present.
-fn needed(upright: bool, witness: bool, fluid: bool) -> u32 {
-    match (upright, witness, fluid) {
-        (true, ..) => 5,
-        (false, true, _) => 4,
-        (false, false, true) => 3,
-        (false, false, false) => 2,
+/// The oldest format with the close-packed grid, upright grains, a witness contact point and
+/// fluid forces if these are present.
+fn needed(hcp: bool, upright: bool, witness: bool, fluid: bool) -> u32 {
+    match (hcp, upright, witness, fluid) {
+        (true, ..) => 6,
+        (false, true, ..) => 5,
+        (false, false, true, _) => 4,
+        (false, false, false, true) => 3,
+        (false, false, false, false) => 2,
     }
 }
 /// A mesh folder's name in a format 2 identity.
@@ -205,6 +215,16 @@ mod v1 {
         /// they were.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub(super) orientation: Option<Orientation>,
+        /// Format 6 only; absent (the cubic grid), it leaves the bytes of formats 1 to 5 as
+        /// they were.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub(super) grid: Option<Grid>,
+    }
+
+    /// A grid of new grains other than the cubic one, the only one formats 1 to 5 know.
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    pub(super) enum Grid {
+        Hcp,
     }
 
     /// An orientation of new grains other than random, the only one formats 1 to 4 know.
@@ -226,7 +246,7 @@ mod v1 {
     }
 }
 
-/// Formats 2 to 5: format 1's job with the place of its mesh folder taken out of it.
+/// Formats 2 to 6: format 1's job with the place of its mesh folder taken out of it.
 mod v2 {
     use serde::{Deserialize, Serialize};
 
@@ -264,7 +284,7 @@ pub fn job_id(job: &JobSpec) -> String {
 pub fn decode(format: u32, json: &serde_json::Value) -> anyhow::Result<JobSpec> {
     let job = match format {
         1 => serde_json::from_value(json.clone()).context("the stored job is not format 1")?,
-        2..=5 => {
+        2..=6 => {
             let v2::Job { mut job, mesh_folder } = serde_json::from_value(json.clone())
                 .with_context(|| format!("the stored job is not format {format}"))?;
             let named = job.packing.grains.meshes.as_mut().map(|m| &mut m.source);
@@ -285,11 +305,13 @@ pub fn decode(format: u32, json: &serde_json::Value) -> anyhow::Result<JobSpec> 
         ),
     };
     let p = &job.packing;
-    let wanted = needed(p.process.orientation.is_some(), p.contact_point.is_some(), p.fluid.is_some());
+    let wanted =
+        needed(p.process.grid.is_some(), p.process.orientation.is_some(), p.contact_point.is_some(), p.fluid.is_some());
     if wanted != format && !(format == 1 && wanted == 2) {
         bail!(
             "the stored job is not format {format}: format 3 is the one with fluid forces, format 4 the one \
-             with EPA's witness as the contact point of polyhedra, format 5 the one with upright grains"
+             with EPA's witness as the contact point of polyhedra, format 5 the one with upright grains, format 6 \
+             the one with the close-packed grid"
         );
     }
     from_v1(job)
@@ -368,6 +390,10 @@ fn from_v1(job: v1::Job) -> anyhow::Result<JobSpec> {
             orientation: match p.process.orientation {
                 None => Orientation::Random,
                 Some(v1::Orientation::Upright) => Orientation::Upright,
+            },
+            grid: match p.process.grid {
+                None => Grid::Cubic,
+                Some(v1::Grid::Hcp) => Grid::Hcp,
             },
             shaking: Shaking { amplitude: p.process.shaking.amplitude, period: p.process.shaking.period },
             shaking_duration: p.process.shaking_duration,
@@ -465,6 +491,10 @@ fn identity(job: &JobSpec) -> v1::Job {
                 orientation: match p.orientation {
                     Orientation::Random => None,
                     Orientation::Upright => Some(v1::Orientation::Upright),
+                },
+                grid: match p.grid {
+                    Grid::Cubic => None,
+                    Grid::Hcp => Some(v1::Grid::Hcp),
                 },
             },
             slice: spec.slice,
@@ -654,10 +684,41 @@ mod tests {
     }
 
     #[test]
+    fn a_job_on_the_close_packed_grid_is_format_6_and_the_cubic_grid_keeps_its_id() {
+        let mut spec = PackingSpec::paper(DomainKind::Cylinder);
+        spec.process.grid = Grid::Hcp;
+        let original = job(spec);
+        assert_eq!(format(&original), 6);
+        let stored = encode(&original);
+        assert_eq!(stored["job"]["packing"]["process"]["grid"], "Hcp");
+        let back = decode(6, &stored).unwrap();
+        assert_eq!(back.packing.process.grid, Grid::Hcp);
+        assert_eq!(canonical_json(&back), canonical_json(&original));
+        let cubic = job(PackingSpec::paper(DomainKind::Cylinder));
+        assert_ne!(job_id(&original), job_id(&cubic));
+        // The cubic grid is what formats 1 to 5 mean: no key, the same bytes and id.
+        assert!(encode(&cubic)["job"]["packing"]["process"].get("grid").is_none());
+        assert_eq!(format(&cubic), 2);
+        // With upright grains and the witness too it is format 6; older formats refuse it.
+        let mut all = original.clone();
+        all.packing.contact_point = ContactPoint::Witness;
+        all.packing.process.orientation = Orientation::Upright;
+        assert_eq!(format(&all), 6);
+        let back = decode(6, &encode(&all)).unwrap();
+        assert_eq!((back.packing.process.orientation, back.packing.process.grid), (Orientation::Upright, Grid::Hcp));
+        for older in [2, 4, 5] {
+            let error = decode(older, &stored).unwrap_err().to_string();
+            assert!(error.contains("format 6 the one with the close-packed grid"), "{error}");
+        }
+        let error = decode(6, &encode(&cubic)).unwrap_err().to_string();
+        assert!(error.contains("not format 6"), "{error}");
+    }
+
+    #[test]
     fn stored_jobs_that_disagree_with_themselves_or_another_format_are_refused() {
         let stored = encode(&job(PackingSpec::paper(DomainKind::Periodic)));
-        let error = decode(6, &stored).unwrap_err().to_string();
-        assert!(error.contains("format 6") && error.contains("formats 1 to 5"), "{error}");
+        let error = decode(7, &stored).unwrap_err().to_string();
+        assert!(error.contains("format 7") && error.contains("formats 1 to 6"), "{error}");
         let error = format!("{:#}", decode(1, &stored).unwrap_err());
         assert!(error.contains("not format 1"), "{error}");
         let error = decode(3, &stored).unwrap_err().to_string();

@@ -98,6 +98,8 @@ fn bad_job_files_name_the_file_line_and_key() {
     fails(&["pack", &point], &["point.yaml:2", "contact_point", "centre-of-pressure", "witness"]);
     let lying = write(dir.path(), "lying.yaml", "process:\n  generation:\n    orientation: flat\n");
     fails(&["pack", &lying], &["lying.yaml:3", "orientation", "random", "upright"]);
+    let grid = write(dir.path(), "grid.yaml", "process:\n  generation:\n    grid: hexagonal\n");
+    fails(&["pack", &grid], &["grid.yaml:3", "grid", "cubic", "hcp"]);
     let step = write(dir.path(), "step.yaml", "solver: {time_step: 1.0e-4}\n");
     fails(&["pack", &step], &["step.yaml:1", "solver.time_step", "collision_time / 10"]);
     let case = write(dir.path(), "case.yaml", "grains: {size: U4}\n");

@@ -213,6 +213,33 @@ fn the_calibration_and_orientation_studies_are_the_contact_points_u1_with_one_ch
     }
 }
 
+/// The grid study is Table 6's U5 and B50 of validation-cylinder-witness with only the grid
+/// changed, stored in format 6, and still the paper's setup for the report.
+#[test]
+fn the_grid_study_is_the_witness_cylinders_u5_and_b50_on_the_close_packed_grid() {
+    use solver::packing::Grid;
+    let study = read("campaigns/validation-rain-grid.yaml");
+    let reference = read("campaigns/validation-cylinder-witness.yaml");
+    assert_eq!(study.jobs.len(), 6);
+    for job in &study.jobs {
+        let changed = &job.spec.packing;
+        assert_eq!(sedpack::stored::format(&job.spec), 6);
+        let case = changed.grains.size.case().map(|c| c.name);
+        let paper = analysis::paper::simulated_porosity(changed).unwrap();
+        let expected = if case == Some("U5") { 0.333 } else { 0.280 };
+        assert_eq!((paper.table.as_str(), paper.porosity), ("Table 6", expected), "{case:?}");
+        let cubic = reference
+            .jobs
+            .iter()
+            .map(|j| &j.spec.packing)
+            .find(|p| p.seed == changed.seed && p.grains.size.case().map(|c| c.name) == case)
+            .unwrap();
+        let mut same = changed.clone();
+        assert_eq!(std::mem::replace(&mut same.process.grid, Grid::Cubic), Grid::Hcp);
+        assert_eq!(&same, cubic, "{case:?}, seed {}", changed.seed);
+    }
+}
+
 #[test]
 fn table_11_draws_the_rhine_forms_and_the_scans_study_is_the_packing_it_ran_before() {
     use solver::dem::ContactPoint;

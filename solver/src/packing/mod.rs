@@ -6,8 +6,8 @@
 mod spec;
 
 pub use spec::{
-    Derived, DomainKind, FLUID_COUPLING, FluidSpec, FormSpec, GrainSpec, Orientation, PackingSpec, Process, ShapeKind,
-    SpecError, in_range,
+    Derived, DomainKind, FLUID_COUPLING, FluidSpec, FormSpec, GrainSpec, Grid, Orientation, PackingSpec, Process,
+    ShapeKind, SpecError, in_range,
 };
 
 use std::f64::consts::FRAC_PI_2;
@@ -462,8 +462,17 @@ impl Packing {
     }
 }
 
-/// Grid positions of the generation region z ∈ [0.6, 1]·H, spacing h_g, centred horizontally.
+/// Grid positions of the generation region z ∈ [0.6, 1]·H, spacing h_g, each at least h_g/2
+/// inside the domain's side (within R − h_g/2 of a cylinder's axis).
 fn generation_grid(spec: &PackingSpec, derived: &Derived) -> Vec<Vector3<f64>> {
+    match spec.process.grid {
+        Grid::Cubic => cubic_grid(spec, derived),
+        Grid::Hcp => hcp_grid(spec, derived),
+    }
+}
+
+/// The cubic grid, centred horizontally.
+fn cubic_grid(spec: &PackingSpec, derived: &Derived) -> Vec<Vector3<f64>> {
     let (h, height) = (derived.spacing, derived.height);
     let l = spec.domain.width();
     let per_row = (l / h).floor() as usize;
@@ -476,6 +485,35 @@ fn generation_grid(spec: &PackingSpec, derived: &Derived) -> Vec<Vector3<f64>> {
                 let p = Vector3::new(offset + i as f64 * h, offset + j as f64 * h, 0.6 * height + (k as f64 + 0.5) * h);
                 if spec.domain.holds(p.x, p.y, h / 2.0) {
                     grid.push(p);
+                }
+            }
+        }
+    }
+    grid
+}
+
+/// The hexagonal close-packed grid of the paper's software, laid out from the domain's axis:
+/// rows of positions h_g apart, rows √3/2 h_g apart and shifted by h_g/2 in turn, layers
+/// √(2/3) h_g apart and shifted by a third of a row spacing in turn (waLBerla's `HCPGrid`),
+/// so that every position has its nearest neighbours h_g away. The software fills it from the
+/// axis outwards to where the cubic grid stops, h_g/2 inside the side.
+fn hcp_grid(spec: &PackingSpec, derived: &Derived) -> Vec<Vector3<f64>> {
+    let (h, height) = (derived.spacing, derived.height);
+    let l = spec.domain.width();
+    let c = l / 2.0;
+    let (dy, dz) = (h * 3f64.sqrt() / 2.0, h * (2.0f64 / 3.0).sqrt());
+    let layers = (0.4 * height / dz).floor() as usize;
+    let (rows, columns) = ((c / dy).ceil() as i64 + 1, (c / h).ceil() as i64 + 1);
+    let mut grid = Vec::new();
+    for k in 0..layers {
+        let z = 0.6 * height + (k as f64 + 0.5) * dz;
+        for j in -rows..=rows {
+            let y = c + dy * (j as f64 + (k % 2) as f64 / 3.0);
+            for i in -columns..=columns {
+                let x = c + h * (i as f64 + (j + k as i64).rem_euclid(2) as f64 / 2.0);
+                let inside = |u: f64| (h / 2.0..=l - h / 2.0).contains(&u);
+                if inside(x) && inside(y) && spec.domain.holds(x, y, h / 2.0) {
+                    grid.push(Vector3::new(x, y, z));
                 }
             }
         }
@@ -590,6 +628,66 @@ mod tests {
         let mean = random.iter().map(|(long, _)| long.z.abs()).sum::<f64>() / random.len() as f64;
         let tolerance = 4.0 / (12.0 * random.len() as f64).sqrt();
         assert!((mean - 0.5).abs() < tolerance, "mean |cos| {mean} over {} grains", random.len());
+    }
+
+    fn grid_of(domain: crate::dem::Domain, height: f64, spacing: f64, grid: Grid) -> Vec<Vector3<f64>> {
+        let mut spec = PackingSpec::paper(DomainKind::Cylinder);
+        (spec.domain, spec.height, spec.process.spacing, spec.process.grid) =
+            (domain, Some(height), Some(spacing), grid);
+        generation_grid(&spec, &spec.derived())
+    }
+
+    /// Table 6's U5 (h_g = 26 mm) in the 0.104 m cylinder, H = 1 m, positions within R − h_g/2
+    /// = 39 mm of the axis, counted by hand. Cubic: positions ±13 and ±39 mm off the axis in x
+    /// and y, of which only the four at (±13, ±13) mm lie within 39 mm ((39, 13) is 41.1 mm
+    /// out), in floor(0.4 m / 26 mm) = 15 layers: 60. Close-packed: layers √(2/3)·26 = 21.2 mm
+    /// apart, 18 in 0.4 m; rows 22.5 mm apart; a layer through the axis holds it, two at 26 mm
+    /// on its row and two on each next row (13, ±22.5) mm: 7; the layers between are shifted
+    /// by a third of a row: (±13, 7.5), (0 and ±26, −15) and (0, 30) mm, 15.0–30.0 mm out: 6.
+    /// 9 × 7 + 9 × 6 = 117, the rain of new grains almost twice as dense.
+    #[test]
+    fn the_generation_grids_of_u5_in_the_cylinder_hold_the_positions_counted_by_hand() {
+        let cylinder = crate::dem::Domain::Cylinder { diameter: 0.104 };
+        let cubic = grid_of(cylinder, 1.0, 0.026, Grid::Cubic);
+        let hcp = grid_of(cylinder, 1.0, 0.026, Grid::Hcp);
+        assert_eq!((cubic.len(), hcp.len()), (60, 117));
+        let layer = |z: f64| ((z - 0.6) / (0.026 * (2.0f64 / 3.0).sqrt()) - 0.5).round() as usize;
+        for k in 0..18 {
+            let count = hcp.iter().filter(|p| layer(p.z) == k).count();
+            assert_eq!(count, if k % 2 == 0 { 7 } else { 6 }, "layer {k}");
+        }
+        for p in cubic.iter().chain(&hcp) {
+            assert!((p.x - 0.052).hypot(p.y - 0.052) <= 0.039 + 1e-12 && (0.6..=1.0).contains(&p.z), "{p}");
+        }
+    }
+
+    /// The close-packed grid is HCP: in a periodic box no two positions (or periodic images)
+    /// are nearer than h_g, and a position away from the box's sides, bottom and top has its
+    /// twelve nearest neighbours exactly h_g away (six in its layer, three above, three below).
+    #[test]
+    fn the_close_packed_grid_has_twelve_nearest_neighbours_at_the_spacing() {
+        let (l, h) = (0.1, 0.01);
+        let domain = crate::dem::Domain::Periodic { width: l };
+        let grid = grid_of(domain, 0.5, h, Grid::Hcp);
+        let (bottom, top) = (0.6 * 0.5, 0.5);
+        let mut interior = 0;
+        for (a, p) in grid.iter().enumerate() {
+            let distances: Vec<f64> = grid
+                .iter()
+                .enumerate()
+                .filter(|&(b, _)| b != a)
+                .map(|(_, q)| domain.nearest_distance2(p, q).sqrt())
+                .collect();
+            let nearest = distances.iter().fold(f64::INFINITY, |m, &d| m.min(d));
+            assert!(nearest >= h * (1.0 - 1e-12), "{p}: a position {nearest} m away");
+            let away = |u: f64| (2.0 * h..=l - 2.0 * h).contains(&u);
+            if away(p.x) && away(p.y) && p.z > bottom + 2.0 * h && p.z < top - 2.0 * h {
+                interior += 1;
+                let at_h = distances.iter().filter(|&&d| (d - h).abs() < 1e-12).count();
+                assert_eq!(at_h, 12, "{p}");
+            }
+        }
+        assert!(interior > 100, "{interior} interior positions");
     }
 
     /// A grain that no turn fits into the domain is an error naming the grain, not a set that

@@ -90,6 +90,17 @@ pub enum Orientation {
     Upright,
 }
 
+/// The grid new grains are created on, spacing h_g (§4.3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Grid {
+    /// The text's "hexahedral grid": cubic, centred in the domain (sedpack's).
+    Cubic,
+    /// Hexagonal close-packed, laid out from the domain's axis as the paper's software lays
+    /// its grid (waLBerla's `HCPGrid`): nearest positions h_g apart as on the cubic grid, but
+    /// rows √3/2 h_g and layers √(2/3) h_g apart, so more of them in the same region.
+    Hcp,
+}
+
 /// Process parameters of §4.3 (generation, shaking, damping, convergence).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Process {
@@ -100,6 +111,8 @@ pub struct Process {
     pub velocity: f64,
     /// How each new grain is turned.
     pub orientation: Orientation,
+    /// The grid of the generation region.
+    pub grid: Grid,
     pub shaking: Shaking,
     /// Shaking continues this long after the last grain was created, t_s (s).
     pub shaking_duration: f64,
@@ -206,6 +219,7 @@ impl PackingSpec {
                 spacing: None,
                 velocity: 1.0,
                 orientation: Orientation::Random,
+                grid: Grid::Cubic,
                 shaking: Shaking { amplitude: 3e-4, period: 0.025 },
                 shaking_duration,
                 damping: 1e-3,
