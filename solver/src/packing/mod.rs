@@ -495,8 +495,8 @@ fn cubic_grid(spec: &PackingSpec, derived: &Derived) -> Vec<Vector3<f64>> {
 /// The hexagonal close-packed grid of the paper's software, laid out from the domain's axis:
 /// rows of positions h_g apart, rows √3/2 h_g apart and shifted by h_g/2 in turn, layers
 /// √(2/3) h_g apart and shifted by a third of a row spacing in turn (waLBerla's `HCPGrid`),
-/// so that every position has its nearest neighbours h_g away. The software fills it from the
-/// axis outwards to where the cubic grid stops, h_g/2 inside the side.
+/// so that every position has its nearest neighbours h_g away. Its positions reach, as the
+/// cubic grid's do, to h_g/2 inside the domain's side.
 fn hcp_grid(spec: &PackingSpec, derived: &Derived) -> Vec<Vector3<f64>> {
     let (h, height) = (derived.spacing, derived.height);
     let l = spec.domain.width();
@@ -504,6 +504,7 @@ fn hcp_grid(spec: &PackingSpec, derived: &Derived) -> Vec<Vector3<f64>> {
     let (dy, dz) = (h * 3f64.sqrt() / 2.0, h * (2.0f64 / 3.0).sqrt());
     let layers = (0.4 * height / dz).floor() as usize;
     let (rows, columns) = ((c / dy).ceil() as i64 + 1, (c / h).ceil() as i64 + 1);
+    let inside = |u: f64| (h / 2.0..=l - h / 2.0).contains(&u);
     let mut grid = Vec::new();
     for k in 0..layers {
         let z = 0.6 * height + (k as f64 + 0.5) * dz;
@@ -511,7 +512,6 @@ fn hcp_grid(spec: &PackingSpec, derived: &Derived) -> Vec<Vector3<f64>> {
             let y = c + dy * (j as f64 + (k % 2) as f64 / 3.0);
             for i in -columns..=columns {
                 let x = c + h * (i as f64 + (j + k as i64).rem_euclid(2) as f64 / 2.0);
-                let inside = |u: f64| (h / 2.0..=l - h / 2.0).contains(&u);
                 if inside(x) && inside(y) && spec.domain.holds(x, y, h / 2.0) {
                     grid.push(Vector3::new(x, y, z));
                 }
