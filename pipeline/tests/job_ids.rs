@@ -323,12 +323,20 @@ fn table_11s_u7_shaken_1_s_differs_from_table_11s_u7_by_the_shaking_and_from_tab
 }
 
 #[test]
-fn the_cylinders_rhine_forms_study_is_table_6s_u1_under_the_witness_but_for_the_forms() {
+fn the_cylinders_rhine_forms_study_is_table_6s_u1_and_u7_under_the_witness_but_for_the_forms() {
     use solver::grain::form_distribution::RHINE_FORMS;
     use solver::packing::FormSpec;
     let study = read("campaigns/validation-cylinder-rhine-forms.yaml");
     let witness = read("campaigns/validation-contact-point.yaml");
-    assert_eq!(study.jobs.len(), 3);
+    assert_eq!(study.jobs.len(), 6);
+    // U1's jobs keep the ids they were stored under (6173343) before U7 joined the grid.
+    let u1: Vec<&str> = study
+        .jobs
+        .iter()
+        .filter(|j| j.spec.packing.grains.size.case().map(|c| c.name) == Some("U1"))
+        .map(|j| j.id.as_str())
+        .collect();
+    assert_eq!(u1, ["d0996bcdaf1a4f13", "999914214b5adebf", "9ac2ec31060c3d5c"]);
     for job in &study.jobs {
         let drawn = &job.spec.packing;
         assert_eq!(drawn.grains.form, FormSpec::Distribution(RHINE_FORMS));
@@ -340,7 +348,7 @@ fn the_cylinders_rhine_forms_study_is_table_6s_u1_under_the_witness_but_for_the_
             .jobs
             .iter()
             .map(|j| &j.spec.packing)
-            .find(|p| p.seed == drawn.seed && p.grains.size.case().map(|c| c.name) == Some("U1"))
+            .find(|p| p.seed == drawn.seed && p.grains.size.case() == drawn.grains.size.case())
             .unwrap();
         let mut same = drawn.clone();
         same.grains.form = FormSpec::Own;
