@@ -12,8 +12,13 @@
 //!   they hold, in a box 8 to 10 typical grains wide, poured until every grain has landed (none moves
 //!   faster than 0.1 m/s), then damped (Eq. 15) until ⟨z⟩ changes by less than 1e-5 m over 0.01 s (§4.3).
 //!
+//! [`rain`] adds to a bed one lattice layer of new grains of its kind, falling at 1 m/s onto it
+//! from just above: the raining state of `sedpack bench`, in which a packing spends most of its
+//! generation.
+//!
 //! The material and time step are the paper's (§4.2).
 
+use std::iter::Peekable;
 use std::sync::Arc;
 
 use nalgebra::{UnitQuaternion, Vector3};
@@ -23,7 +28,9 @@ use rand_chacha::ChaCha8Rng;
 use crate::SolverError;
 use crate::dem::shape::{ConvexPolyhedron, Polyhedron};
 use crate::dem::{Calibration, ContactPoint, Domain, Material, NewBody, Settings, Shape, Simulation, uniform_rotation};
-use crate::grain::{RHINE_FORMS, SieveCurve, UnitMesh, bonded_grain, rhine_meshes, simplify};
+use crate::grain::{
+    FormParameters, FormSampler, RHINE_FORMS, SieveCurve, SizeSampler, UnitMesh, bonded_grain, rhine_meshes, simplify,
+};
 use crate::packing::ShapeKind;
 
 /// Diameter of the LAMMPS bed's spheres (m).
@@ -184,48 +191,108 @@ fn sphere_lattice(grains: usize, rng: &mut ChaCha8Rng) -> Result<Simulation, Sol
     Ok(sim)
 }
 
+/// Draws grains of a bed's kind, as its lattice drew them: spheres of the LAMMPS bed, the others
+/// of the 5.6–8 mm class.
+struct GrainDraw {
+    kind: ShapeKind,
+    sizes: SizeSampler,
+    forms: FormSampler,
+    /// The Rhine scans simplified to ≤ 300 faces, and their own forms.
+    bases: Vec<Arc<ConvexPolyhedron>>,
+    own: Vec<FormParameters>,
+}
+
+impl GrainDraw {
+    fn new(kind: ShapeKind) -> Self {
+        let bases = match kind {
+            ShapeKind::Mesh => rhine_meshes()
+                .iter()
+                .map(|(_, m)| {
+                    let unit =
+                        UnitMesh::new(&simplify(m, 300).expect("the Rhine scans simplify").mesh).expect("unit form");
+                    Arc::new(ConvexPolyhedron::new(unit.mesh()).expect("the Rhine scans are convex"))
+                })
+                .collect(),
+            _ => Vec::new(),
+        };
+        Self {
+            kind,
+            sizes: SieveCurve::new(CLASS.to_vec(), vec![1.0]).expect("one class").sampler(),
+            forms: RHINE_FORMS.sampler().expect("Table 2's distribution lies in the admissible ranges"),
+            bases,
+            own: rhine_meshes().iter().map(|(_, m)| UnitMesh::new(m).expect("unit form").original_form()).collect(),
+        }
+    }
+
+    fn draw(&self, rng: &mut ChaCha8Rng) -> Shape {
+        let (_, size) = self.sizes.sample(rng);
+        match self.kind {
+            ShapeKind::Mesh => {
+                let k = rng.random_range(0..self.bases.len());
+                let form = self.own[k].scaled_to_size(size);
+                Shape::Polyhedron(Box::new(
+                    Polyhedron::with_form(self.bases[k].clone(), &form).expect("a valid stretch"),
+                ))
+            }
+            ShapeKind::Ellipsoid => {
+                let form = self.forms.sample(size, rng);
+                Shape::Ellipsoid { semi_axes: Vector3::new(form.l, form.i, form.s) / 2.0 }
+            }
+            ShapeKind::BondedSpheres => {
+                Shape::from(&bonded_grain(&self.forms.sample(size, rng)).expect("sampled forms are valid"))
+            }
+            ShapeKind::Sphere => Shape::Sphere { radius: SPHERE_DIAMETER / 2.0 },
+        }
+    }
+}
+
+/// Takes the grains of one lattice layer from `shapes`: as many as its sites hold, spaced for
+/// the longest grain taken, so that a few long grains of the distribution's tail do not spread a
+/// whole bed thin. Returns them with the spacing.
+fn next_layer(shapes: &mut Peekable<impl Iterator<Item = Shape>>, width: f64) -> (Vec<Shape>, f64) {
+    let mut layer: Vec<Shape> = Vec::new();
+    let mut spacing = 0.0f64;
+    while let Some(next) = shapes.peek() {
+        let wider = spacing.max(2.1 * next.bounding_radius());
+        let sites = ((width / wider).floor() as usize).max(1).pow(2);
+        if layer.len() >= sites {
+            break;
+        }
+        spacing = wider;
+        layer.push(shapes.next().expect("peeked"));
+    }
+    (layer, spacing)
+}
+
+/// Places a layer on its sites, each at the height `height` gives for it (at its site, as turned),
+/// turned at random and falling at 1 m/s (the generation's speed of new grains, §4.3), with
+/// a little sideways speed and spin.
+fn place_layer(
+    sim: &mut Simulation,
+    layer: Vec<Shape>,
+    spacing: f64,
+    height: &dyn Fn(&Simulation, &NewBody) -> f64,
+    rng: &mut ChaCha8Rng,
+) {
+    let row = ((sim.domain.width() / spacing).floor() as usize).max(1);
+    for (k, shape) in layer.into_iter().enumerate() {
+        let (x, y) = ((k % row) as f64 * spacing + spacing / 2.0, (k / row) as f64 * spacing + spacing / 2.0);
+        let mut spin = || rng.random_range(-0.1..0.1);
+        let velocity = Vector3::new(spin(), spin(), -1.0);
+        let angular_velocity = Vector3::new(spin(), spin(), spin()) / spacing;
+        let orientation = uniform_rotation(rng);
+        let mut body = NewBody { shape, position: Vector3::new(x, y, 0.0), orientation, velocity, angular_velocity };
+        body.position.z = height(sim, &body);
+        sim.add_body(body);
+    }
+}
+
 /// Grains of the 5.6–8 mm class on a lattice as wide as their largest reach, falling at 1 m/s.
 fn grain_lattice(spec: &BedSpec, rng: &mut ChaCha8Rng) -> Result<Simulation, SolverError> {
-    let sizes = SieveCurve::new(CLASS.to_vec(), vec![1.0]).expect("one class").sampler();
-    let forms = RHINE_FORMS.sampler().expect("Table 2's distribution lies in the admissible ranges");
-    let bases: Vec<Arc<ConvexPolyhedron>> = match spec.shape {
-        ShapeKind::Mesh => rhine_meshes()
-            .iter()
-            .map(|(_, m)| {
-                let unit = UnitMesh::new(&simplify(m, 300).expect("the Rhine scans simplify").mesh).expect("unit form");
-                Arc::new(ConvexPolyhedron::new(unit.mesh()).expect("the Rhine scans are convex"))
-            })
-            .collect(),
-        _ => Vec::new(),
-    };
-    let own: Vec<_> =
-        rhine_meshes().iter().map(|(_, m)| UnitMesh::new(m).expect("unit form").original_form()).collect();
-    let shapes: Vec<Shape> = (0..spec.grains)
-        .map(|_| {
-            let (_, size) = sizes.sample(rng);
-            match spec.shape {
-                ShapeKind::Mesh => {
-                    let k = rng.random_range(0..bases.len());
-                    let form = own[k].scaled_to_size(size);
-                    Shape::Polyhedron(Box::new(
-                        Polyhedron::with_form(bases[k].clone(), &form).expect("a valid stretch"),
-                    ))
-                }
-                ShapeKind::Ellipsoid => {
-                    let form = forms.sample(size, rng);
-                    Shape::Ellipsoid { semi_axes: Vector3::new(form.l, form.i, form.s) / 2.0 }
-                }
-                ShapeKind::BondedSpheres => {
-                    Shape::from(&bonded_grain(&forms.sample(size, rng)).expect("sampled forms are valid"))
-                }
-                ShapeKind::Sphere => Shape::Sphere { radius: size / 2.0 },
-            }
-        })
-        .collect();
+    let draw = GrainDraw::new(spec.shape);
+    let shapes: Vec<Shape> = (0..spec.grains).map(|_| draw.draw(rng)).collect();
     // The box is as wide as 8 to 10 typical grains (each row of sites 2.1 median reaches
-    // apart), or wider if a long grain needs it; each layer of the lattice is spaced for the
-    // longest grain it holds, so a few long grains of the distribution's tail do not spread the
-    // whole bed thin.
+    // apart), or wider if a long grain needs it.
     let mut reaches: Vec<f64> = shapes.iter().map(Shape::bounding_radius).collect();
     let longest = reaches.iter().cloned().fold(0.0, f64::max);
     reaches.sort_by(f64::total_cmp);
@@ -237,30 +304,43 @@ fn grain_lattice(spec: &BedSpec, rng: &mut ChaCha8Rng) -> Result<Simulation, Sol
     let mut shapes = shapes.into_iter().peekable();
     let mut z = 0.0;
     while shapes.peek().is_some() {
-        // Fill a layer while its sites, spaced for its longest grain, hold all it has taken.
-        let mut layer: Vec<Shape> = Vec::new();
-        let mut spacing = 0.0f64;
-        while let Some(next) = shapes.peek() {
-            let wider = spacing.max(2.1 * next.bounding_radius());
-            let sites = ((width / wider).floor() as usize).max(1).pow(2);
-            if layer.len() >= sites {
-                break;
-            }
-            spacing = wider;
-            layer.push(shapes.next().expect("peeked"));
-        }
-        let row = ((width / spacing).floor() as usize).max(1);
+        let (layer, spacing) = next_layer(&mut shapes, width);
         z += spacing / 2.0;
-        for (k, shape) in layer.into_iter().enumerate() {
-            let (i, j) = (k % row, k / row);
-            let position = Vector3::new((i as f64 + 0.5) * spacing, (j as f64 + 0.5) * spacing, z);
-            let mut spin = || rng.random_range(-0.1..0.1);
-            let velocity = Vector3::new(spin(), spin(), -1.0);
-            let angular_velocity = Vector3::new(spin(), spin(), spin()) / spacing;
-            let orientation = uniform_rotation(rng);
-            sim.add_body(NewBody { shape, position, orientation, velocity, angular_velocity });
-        }
+        place_layer(&mut sim, layer, spacing, &|_, _| z, rng);
         z += spacing / 2.0;
     }
     Ok(sim)
+}
+
+/// Gap between a grain [`rain`] adds and the highest grain of the bed below it (m).
+pub const RAIN_GAP: f64 = 2e-3;
+
+/// Adds one lattice layer of new grains of `spec`'s kind above `bed`, the state a packing spends
+/// most of its generation in (§4.3): drawn as the bed's grains were (from a stream of their own),
+/// on sites spaced for the longest of them, turned at random and falling at 1 m/s, each with its
+/// lowest point [`RAIN_GAP`] above the highest point of the bed's grains whose bounding spheres
+/// its own could meet on the way down, so that they land within the first few milliseconds.
+/// Returns how many were added.
+pub fn rain(spec: &BedSpec, bed: &mut Simulation) -> usize {
+    let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
+    rng.set_stream(1);
+    let draw = GrainDraw::new(spec.shape);
+    let old = bed.bodies.len();
+    let width = bed.domain.width();
+    let (layer, spacing) = next_layer(&mut std::iter::repeat_with(|| draw.draw(&mut rng)).peekable(), width);
+    let added = layer.len();
+    let height = |sim: &Simulation, new: &NewBody| {
+        let b = &sim.bodies;
+        let apart = |d: f64| d - width * (d / width).round();
+        let below = (0..old)
+            .filter(|&k| {
+                let reach = b.bounding_radius[k] + new.shape.bounding_radius();
+                apart(b.position[k].x - new.position.x).hypot(apart(b.position[k].y - new.position.y)) < reach
+            })
+            .map(|k| b.position[k].z + b.shape[k].reach_along(&b.orientation[k], &Vector3::z()))
+            .fold(0.0, f64::max);
+        below + RAIN_GAP + new.shape.reach_along(&new.orientation, &-Vector3::z())
+    };
+    place_layer(bed, layer, spacing, &height, &mut rng);
+    added
 }

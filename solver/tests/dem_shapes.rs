@@ -215,10 +215,10 @@ fn a_bonded_rod_dropped_on_end_comes_to_rest_lying_down() {
 }
 
 /// The horizontal reach of a turned grain (how far it extends from its centre in the plane,
-/// what a cylinder must leave it) against a brute-force maximum over its surface: for a box the
-/// corners, computed by hand from the rotation; for an ellipsoid, and for each sphere of a
-/// bonded rod, points of the surface on a 720 × 360 grid of angles, which can only fall short
-/// of the maximum, by less than 1e-4 of it.
+/// what a cylinder must leave it) and its reach along a direction (up, down, and slanted), against
+/// brute-force maxima over its surface: for a box the corners, computed by hand from the
+/// rotation; for an ellipsoid, and for each sphere of a bonded rod, points of the surface on a
+/// 720 × 360 grid of angles, which can only fall short of the maximum, by less than 1e-4 of it.
 #[test]
 fn the_horizontal_reach_of_a_turned_grain_is_its_widest_point_in_the_plane() {
     let turns = [
@@ -228,42 +228,77 @@ fn the_horizontal_reach_of_a_turned_grain_is_its_widest_point_in_the_plane() {
         UnitQuaternion::from_euler_angles(-0.5, 0.9, 0.1),
     ];
     let horizontal = |v: Vector3<f64>| v.x.hypot(v.y);
+    let directions = [Vector3::z(), -Vector3::z(), Vector3::new(0.6, -0.48, 0.64)];
     for turn in turns {
         let (a, b, c) = (0.03, 0.02, 0.01);
-        let corners = (0..8).map(|k| {
-            let sign = |bit: usize| if k & bit == 0 { -1.0 } else { 1.0 };
-            Vector3::new(sign(1) * a / 2.0, sign(2) * b / 2.0, sign(4) * c / 2.0)
-        });
-        let by_hand = corners.map(|v| horizontal(turn * v)).fold(0.0, f64::max);
+        let corners: Vec<_> = (0..8)
+            .map(|k| {
+                let sign = |bit: usize| if k & bit == 0 { -1.0 } else { 1.0 };
+                Vector3::new(sign(1) * a / 2.0, sign(2) * b / 2.0, sign(4) * c / 2.0)
+            })
+            .collect();
+        let by_hand = corners.iter().map(|v| horizontal(turn * v)).fold(0.0, f64::max);
         let reach = box_shape(a, b, c).horizontal_reach(&turn);
         assert!((reach - by_hand).abs() < 1e-12, "box: {reach} vs {by_hand}");
+        for d in &directions {
+            let by_hand = corners.iter().map(|v| (turn * v).dot(d)).fold(f64::MIN, f64::max);
+            let reach = box_shape(a, b, c).reach_along(&turn, d);
+            assert!((reach - by_hand).abs() < 1e-12, "box along {d:?}: {reach} vs {by_hand}");
+        }
 
         let semi_axes = Vector3::new(0.04, 0.015, 0.006);
         let mut sampled = 0.0_f64;
+        let mut along = [f64::MIN; 3];
         for i in 0..720 {
             for j in 0..=360 {
                 let (phi, theta) = (i as f64 * std::f64::consts::PI / 360.0, j as f64 * std::f64::consts::PI / 360.0);
                 let unit = Vector3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
-                sampled = sampled.max(horizontal(turn * unit.component_mul(&semi_axes)));
+                let point = turn * unit.component_mul(&semi_axes);
+                sampled = sampled.max(horizontal(point));
+                for (m, d) in along.iter_mut().zip(&directions) {
+                    *m = m.max(point.dot(d));
+                }
             }
         }
-        let reach = Shape::Ellipsoid { semi_axes }.horizontal_reach(&turn);
+        let ellipsoid = Shape::Ellipsoid { semi_axes };
+        let reach = ellipsoid.horizontal_reach(&turn);
         assert!(reach >= sampled - 1e-12 && reach - sampled < 1e-4 * reach, "ellipsoid: {reach} vs {sampled}");
+        for (sampled, d) in along.iter().zip(&directions) {
+            let reach = ellipsoid.reach_along(&turn, d);
+            assert!(
+                reach >= sampled - 1e-12 && reach - sampled < 1e-4 * reach,
+                "ellipsoid along {d:?}: {reach} vs {sampled}"
+            );
+        }
 
         let rod = bonded_grain(&FormParameters::new(0.03, 0.01, 0.01).unwrap()).unwrap();
         let mut sampled = 0.0_f64;
+        let mut along = [f64::MIN; 3];
         for sphere in &rod.spheres {
             for i in 0..720 {
                 for j in 0..=360 {
                     let (phi, theta) =
                         (i as f64 * std::f64::consts::PI / 360.0, j as f64 * std::f64::consts::PI / 360.0);
                     let unit = Vector3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
-                    sampled = sampled.max(horizontal(turn * (sphere.center + unit * sphere.radius)));
+                    let point = turn * (sphere.center + unit * sphere.radius);
+                    sampled = sampled.max(horizontal(point));
+                    for (m, d) in along.iter_mut().zip(&directions) {
+                        *m = m.max(point.dot(d));
+                    }
                 }
             }
         }
-        let reach = Shape::from(&rod).horizontal_reach(&turn);
+        let rod = Shape::from(&rod);
+        let reach = rod.horizontal_reach(&turn);
         assert!(reach >= sampled - 1e-12 && reach - sampled < 1e-4 * reach, "bonded rod: {reach} vs {sampled}");
+        for (sampled, d) in along.iter().zip(&directions) {
+            let reach = rod.reach_along(&turn, d);
+            assert!(
+                reach >= sampled - 1e-12 && reach - sampled < 1e-4 * reach,
+                "bonded rod along {d:?}: {reach} vs {sampled}"
+            );
+        }
     }
     assert_eq!(Shape::Sphere { radius: 0.01 }.horizontal_reach(&turns[1]), 0.01);
+    assert_eq!(Shape::Sphere { radius: 0.01 }.reach_along(&turns[1], &directions[2]), 0.01);
 }

@@ -1,6 +1,7 @@
 //! `sedpack bench`: the engine's speed on standard settled beds ([`solver::bed`]), per shape,
-//! thread count and state (at rest, or shaken by Eq. 14 with the paper's amplitude and period),
-//! from beds built once and cached.
+//! thread count and state (at rest; shaken by Eq. 14 with the paper's amplitude and period; or
+//! shaken while a layer of new grains lands on it, as in the generation of §4.3), from beds built
+//! once and cached.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -8,7 +9,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
-use solver::bed::{BedSpec, build};
+use solver::bed::{BedSpec, build, rain};
 use solver::dem::{Shaking, Shape, Simulation};
 use solver::packing::ShapeKind;
 
@@ -89,8 +90,8 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         }
         let steps = args.steps.unwrap_or(((WORK / bed.bodies.len() as f64).ceil() as u64).max(50));
         for &t in &threads {
-            for shaken in [false, true] {
-                let row = measure(&spec, &bed, t, steps, shaken)?;
+            for state in [State::Settled, State::Shaken, State::Raining] {
+                let row = measure(&spec, &bed, t, steps, state)?;
                 if !args.json {
                     print_row(&row, rows.is_empty())?;
                 }
@@ -155,11 +156,25 @@ fn load_average() -> Option<f64> {
     std::fs::read_to_string("/proc/loadavg").ok()?.split_whitespace().next()?.parse().ok()
 }
 
-/// Steps a copy of the bed on `threads` threads, at rest or shaken.
-fn measure(spec: &BedSpec, bed: &Simulation, threads: usize, steps: u64, shaken: bool) -> anyhow::Result<Row> {
+/// What a bed is doing while it is measured.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum State {
+    /// At rest.
+    Settled,
+    /// Under the shaking of Eq. 14.
+    Shaken,
+    /// Shaken while a layer of new grains lands on it ([`rain`]), as in the generation.
+    Raining,
+}
+
+/// Steps a copy of the bed on `threads` threads in `state`.
+fn measure(spec: &BedSpec, bed: &Simulation, threads: usize, steps: u64, state: State) -> anyhow::Result<Row> {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
     let mut sim = bed.clone();
-    sim.shaking = shaken.then_some(SHAKING);
+    sim.shaking = (state != State::Settled).then_some(SHAKING);
+    if state == State::Raining {
+        rain(spec, &mut sim);
+    }
     let load = load_average();
     let (elapsed, contact_time, pair_contacts, all_contacts) = pool.install(|| -> anyhow::Result<_> {
         for _ in 0..WARM_UP {
@@ -182,7 +197,11 @@ fn measure(spec: &BedSpec, bed: &Simulation, threads: usize, steps: u64, shaken:
         shape: shape_name(spec.shape),
         grains: n,
         threads,
-        state: if shaken { "shaken" } else { "settled" },
+        state: match state {
+            State::Settled => "settled",
+            State::Shaken => "shaken",
+            State::Raining => "raining",
+        },
         steps,
         seconds,
         particle_steps_per_second: (n as u64 * steps) as f64 / seconds,

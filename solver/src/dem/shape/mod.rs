@@ -118,6 +118,22 @@ impl Shape {
         }
     }
 
+    /// Largest extent of the shape beyond its centre of mass along the unit `direction` when
+    /// turned by `orientation` (its support function): how far above its centre a grain reaches
+    /// for `direction` = ẑ.
+    pub fn reach_along(&self, orientation: &UnitQuaternion<f64>, direction: &Vector3<f64>) -> f64 {
+        let d = orientation.inverse_transform_vector(direction);
+        match self {
+            Shape::Sphere { radius } => *radius,
+            Shape::Ellipsoid { semi_axes } => semi_axes.component_mul(&d).norm(),
+            Shape::Bonded(b) => b.spheres.iter().map(|c| c.center.dot(&d) + c.radius).fold(f64::MIN, f64::max),
+            Shape::Polyhedron(p) => {
+                let d = p.scale.component_mul(&d);
+                p.base.vertices().iter().map(|v| v.dot(&d)).fold(f64::MIN, f64::max)
+            }
+        }
+    }
+
     /// L, I, S of the shape: the full axes of a sphere or ellipsoid, the axes a bonded grain was
     /// built for.
     pub fn form(&self) -> FormParameters {
