@@ -152,6 +152,42 @@ fn only_runs_the_jobs_of_the_grid_values_asked_for_and_leaves_the_others_pending
     assert!(by_state(JobState::Pending).is_empty());
 }
 
+/// A grid that gains an axis keeps the jobs it had (their ids, results) and gives them the new
+/// axis's value, so that `status`, `--only` and the report group them with it.
+#[test]
+fn a_grid_that_gains_an_axis_labels_the_jobs_it_had_with_its_value() {
+    let dir = tempfile::tempdir().unwrap();
+    let db = &path_in(dir.path(), "axis.db");
+    let narrow = write(dir.path(), "axis.yaml", &sphere_campaign("axis", 0.02, "seeds: [1]\n"));
+    ok(&["run", &narrow, "--db", db, "--quiet"]);
+    let before = porosities(db, "axis");
+    assert_eq!(rows(db, "axis")[0].parameters.keys().collect::<Vec<_>>(), ["seed"]);
+
+    // The paper's friction, 0.5, is what the first job had: it is the same job.
+    let wider = write(
+        dir.path(),
+        "axis.yaml",
+        &sphere_campaign("axis", 0.02, "grid:\n  material.friction: [0.5, 0.3]\nseeds: [1]\n"),
+    );
+    let text = ok(&["run", &wider, "--db", db, "--quiet"]);
+    assert!(
+        text.contains("2 job(s), 1 new")
+            && text.contains("1 stored job(s) now carry this campaign file's grid values")
+            && text.contains("1 job(s) finished now"),
+        "{text}"
+    );
+    let stored = rows(db, "axis");
+    let kept = stored.iter().find(|r| r.job_id == before[0].0).expect("the first job is kept");
+    assert_eq!(kept.parameters["material.friction"].as_f64(), Some(0.5));
+    assert_eq!(kept.result.as_ref().map(|r| r.porosity.to_bits()), Some(before[0].1), "its result untouched");
+    let picked = ok(&["resume", "axis", "--db", db, "--quiet", "--only", "material.friction=0.5"]);
+    assert!(picked.contains("--only picks 1 job(s), 0 of them pending"), "{picked}");
+    let status = ok(&["status", "axis", "--db", db]);
+    assert!(status.contains("material.friction = 0.5: ") && status.contains("material.friction = 0.3: "), "{status}");
+    let again = ok(&["run", &wider, "--db", db, "--quiet"]);
+    assert!(!again.contains("now carry"), "nothing to relabel: {again}");
+}
+
 #[test]
 fn a_saved_model_predicts_what_its_formula_gives() {
     // A model file as `sedpack report` writes it, with features the §7.3 relations can give.

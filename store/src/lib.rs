@@ -17,7 +17,7 @@ use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use serde::Serialize;
 use serde::de::DeserializeOwned;
-use serde_json::Value;
+use serde_json::{Map, Value};
 use sqlx::sqlite::{
     SqliteConnectOptions, SqliteConnection, SqliteExecutor, SqlitePool, SqlitePoolOptions, SqliteSynchronous,
 };
@@ -232,6 +232,32 @@ impl Store {
     /// no longer running for `from`.
     pub async fn reassign(&self, job_id: &str, from: &str, to: &str) -> Result<bool, StoreError> {
         Ok(self.changed(sqlx::query(sql::REASSIGN_JOB).bind(job_id).bind(from).bind(to).bind(now())).await? == 1)
+    }
+
+    /// Gives the campaign's stored jobs among `jobs` (id → grid parameters) the parameters given,
+    /// in one transaction, and returns how many changed: a job keeps its id when its campaign's
+    /// grid gains an axis (`grains.size: [U1]` becoming `[U1, U7]`), but not its grid values.
+    /// Ids of other campaigns, or unknown, change nothing.
+    pub async fn set_parameters(
+        &self,
+        campaign: &str,
+        jobs: &[(String, Map<String, Value>)],
+    ) -> Result<u64, StoreError> {
+        let mut tx = self.pool.begin_with(sql::BEGIN_IMMEDIATE).await.map_err(self.db())?;
+        let campaign_id = self.campaign_id(&mut tx, campaign).await?;
+        let mut changed = 0;
+        for (id, parameters) in jobs {
+            changed += sqlx::query(sql::SET_PARAMETERS)
+                .bind(id)
+                .bind(campaign_id)
+                .bind(self.encode_json(parameters, &format!("parameters of job {id}"))?)
+                .execute(&mut *tx)
+                .await
+                .map_err(self.db())?
+                .rows_affected();
+        }
+        tx.commit().await.map_err(self.db())?;
+        Ok(changed)
     }
 
     /// Replaces the stored spec of a job that is not done (the same job, described anew); false,

@@ -49,6 +49,8 @@ pub const PENDING_JOBS: &str = "
 pub const REASSIGN_JOB: &str = "
     UPDATE jobs SET worker_id = ?3, heartbeat_at = ?4
     WHERE id = ?1 AND worker_id = ?2 AND state = 'running'";
+pub const SET_PARAMETERS: &str = "
+    UPDATE jobs SET parameters = ?3 WHERE id = ?1 AND campaign_id = ?2 AND parameters <> ?3";
 pub const REPLACE_SPEC: &str = "
     UPDATE jobs SET format = ?2, spec = ?3 WHERE id = ?1 AND state <> 'done'";
 pub const JOBS: &str = "

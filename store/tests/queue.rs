@@ -54,6 +54,35 @@ async fn resubmitting_adds_nothing_and_a_superset_adds_only_the_new_jobs() {
     store.close().await;
 }
 
+/// A job keeps its id when its campaign's grid gains an axis, and takes the new grid values: done
+/// or not, with its result untouched; another campaign's job with the same id is not changed.
+#[tokio::test]
+async fn stored_jobs_take_the_grid_values_of_the_campaign_file_submitted_again() {
+    let dir = tempfile::tempdir().unwrap();
+    let store = store_with_jobs(&db_path(&dir), 3).await;
+    let claimed = store.claim(CAMPAIGN, "w1", None).await.unwrap().unwrap();
+    store.complete(&claimed.id, "w1", &result(0.4), &[]).await.unwrap();
+    let wider = |k: usize| {
+        let mut p = job(k).parameters;
+        p.insert("material.friction".into(), json!(0.5));
+        (job(k).id, p)
+    };
+    let labels: Vec<_> = (0..3).map(wider).collect();
+    assert_eq!(store.set_parameters(CAMPAIGN, &labels).await.unwrap(), 3);
+    let rows = store.export(CAMPAIGN).await.unwrap();
+    for (row, (id, parameters)) in rows.iter().zip(&labels) {
+        assert_eq!((&row.job_id, &row.parameters), (id, parameters));
+    }
+    assert_eq!(rows[0].result.as_ref().map(|r| r.porosity), Some(0.4), "the done job keeps its result");
+    assert_eq!(rows[0].state, JobState::Done);
+    // Unchanged values change nothing; another campaign's ids are not touched.
+    assert_eq!(store.set_parameters(CAMPAIGN, &labels).await.unwrap(), 0);
+    store.upsert_campaign("other", "").await.unwrap();
+    assert_eq!(store.set_parameters("other", &[(job(1).id, job(1).parameters)]).await.unwrap(), 0);
+    assert_eq!(store.export(CAMPAIGN).await.unwrap()[1].parameters, labels[1].1);
+    store.close().await;
+}
+
 #[tokio::test]
 async fn claims_follow_submission_order_and_carry_the_job() {
     let dir = tempfile::tempdir().unwrap();

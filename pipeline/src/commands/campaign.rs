@@ -152,6 +152,13 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
             args.db.display(),
             log.display()
         )?;
+        if added.relabelled > 0 {
+            outln!(
+                "{}: {} stored job(s) now carry this campaign file's grid values (its grid changed)",
+                campaign.name,
+                added.relabelled
+            )?;
+        }
         if added.moved > 0 {
             outln!(
                 "{}: {} job(s) not done now find their mesh folder where this campaign file does",
@@ -207,11 +214,14 @@ struct Added {
     new: u64,
     /// Stored jobs not done whose mesh folder moved, now described with its new place.
     moved: usize,
+    /// Stored jobs whose grid values the campaign file changed (the grid gained an axis).
+    relabelled: u64,
 }
 
 /// Adds the campaign's new jobs. A planned job that is already stored (under its id, or, for a
 /// job of sedpack 0.1.0 with a mesh folder, under the id that version gave it) is not added
-/// again; if it is not done, its stored spec takes the mesh folder's place from the campaign file.
+/// again, but takes the campaign file's grid values; if it is not done, its stored spec takes
+/// the mesh folder's place from the campaign file.
 async fn add_jobs(store: &Store, campaign: &Campaign) -> anyhow::Result<Added> {
     let mut stored_by_identity: HashMap<String, StoredJob> = HashMap::new();
     for job in store.jobs(&campaign.name).await? {
@@ -221,21 +231,24 @@ async fn add_jobs(store: &Store, campaign: &Campaign) -> anyhow::Result<Added> {
         }
     }
     let mut new: Vec<NewJob> = Vec::new();
+    let mut labels = Vec::new();
     let mut moved = 0;
     for planned in &campaign.jobs {
         let job = new_job(planned);
-        match stored_by_identity.get(&planned.id) {
-            None => new.push(job),
-            Some(known) if known.format == job.format && known.spec == job.spec => {}
-            Some(known) => {
-                if store.replace_spec(&known.id, job.format, &job.spec).await? {
-                    info!(job = %known.id, "stored anew: {}", job.spec["mesh_folder"]);
-                    moved += 1;
-                }
-            }
+        let Some(known) = stored_by_identity.get(&planned.id) else {
+            new.push(job);
+            continue;
+        };
+        labels.push((known.id.clone(), job.parameters.clone()));
+        if (known.format != job.format || known.spec != job.spec)
+            && store.replace_spec(&known.id, job.format, &job.spec).await?
+        {
+            info!(job = %known.id, "stored anew: {}", job.spec["mesh_folder"]);
+            moved += 1;
         }
     }
-    Ok(Added { new: store.add_jobs(&campaign.name, &new).await?, moved })
+    let relabelled = store.set_parameters(&campaign.name, &labels).await?;
+    Ok(Added { new: store.add_jobs(&campaign.name, &new).await?, moved, relabelled })
 }
 
 /// Runs or submits the campaign's pending jobs on its executor.
