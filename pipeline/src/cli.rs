@@ -42,8 +42,9 @@ pub enum Command {
     Export(ExportArgs),
     /// Fit and cross-validate porosity models on a campaign and write the report.
     Report(ReportArgs),
-    /// Particle-steps per second of the DEM engine on standard settled beds, per shape and
-    /// thread count: how to size a campaign.
+    /// Particle-steps per second of the DEM engine on standard settled beds, per shape, thread
+    /// count and state (at rest, shaken, or shaken with new grains raining on it): how to size
+    /// a campaign.
     Bench(BenchArgs),
     /// Terminal settling velocity of one grain in still water (the second paper's drag and lift),
     /// beside Haider & Levenspiel's and Dietrich's correlations.
