@@ -326,16 +326,16 @@ pub fn rain(spec: &BedSpec, bed: &mut Simulation) -> usize {
     rng.set_stream(1);
     let draw = GrainDraw::new(spec.shape);
     let old = bed.bodies.len();
-    let width = bed.domain.width();
-    let (layer, spacing) = next_layer(&mut std::iter::repeat_with(|| draw.draw(&mut rng)).peekable(), width);
+    let (layer, spacing) =
+        next_layer(&mut std::iter::repeat_with(|| draw.draw(&mut rng)).peekable(), bed.domain.width());
     let added = layer.len();
     let height = |sim: &Simulation, new: &NewBody| {
-        let b = &sim.bodies;
-        let apart = |d: f64| d - width * (d / width).round();
+        let (b, domain) = (&sim.bodies, &sim.domain);
         let below = (0..old)
             .filter(|&k| {
-                let reach = b.bounding_radius[k] + new.shape.bounding_radius();
-                apart(b.position[k].x - new.position.x).hypot(apart(b.position[k].y - new.position.y)) < reach
+                let image = b.position[k] + domain.shift(domain.nearest_image(&new.position, &b.position[k]));
+                let apart = image - new.position;
+                apart.x.hypot(apart.y) < b.bounding_radius[k] + new.shape.bounding_radius()
             })
             .map(|k| b.position[k].z + b.shape[k].reach_along(&b.orientation[k], &Vector3::z()))
             .fold(0.0, f64::max);
