@@ -323,10 +323,11 @@ fn a_task_stopped_before_its_time_limit_continues_bit_for_bit() {
     let Some(_) = slurm() else { return };
     let _one = CLUSTER.lock().unwrap_or_else(|e| e.into_inner());
     let dir = tempfile::tempdir().unwrap();
-    // One packing of 50–75 s (with 15 s of shaking it took 27 s on a quiet machine, and ended
-    // before the check): Slurm checks limits every 30 s and sends USR1 at the first check within
-    // lead + 30 s of the 1 minute limit, i.e. within 30 s of the start, so the task stops at least once.
-    let file = write(dir.path(), "limit.yaml", &sphere_campaign("limit", 30.0, ""));
+    // One packing that outlasts 30 s on any machine: shaken 45 s it takes ~43 s on one quiet core
+    // (30 s of shaking took 28.5 s there and could end before the check; beside other work
+    // 50–75 s). Slurm checks limits every 30 s and sends USR1 at the first check within lead + 30 s
+    // of the 1 minute limit, i.e. within 30 s of the start, so the task stops at least once.
+    let file = write(dir.path(), "limit.yaml", &sphere_campaign("limit", 45.0, ""));
     let reference = std::thread::spawn({
         let (file, dir) = (file.clone(), dir.path().to_path_buf());
         move || local_reference(&file, &dir)
