@@ -3,8 +3,9 @@
 //! sphericity; flat facets and sharp edges add surface and take volume from the ellipsoid that
 //! shares the grain's inertia, so the ratio of the two sphericities (1 for an ellipsoid, 0.806
 //! for a cube) measures what a packing of the grain sees of its angularity at a given form.
-//! Meshes and ellipsoids of one form pack differently (§6.4, Fig. 10): this is the property in
-//! which two mesh libraries of the same forms can still differ.
+//! Meshes and ellipsoids of one form pack differently (§6.4, Fig. 10): these are properties in
+//! which two mesh libraries of the same forms can still differ, at the surface (sphericity) and
+//! in the bulk (volume ratio).
 
 use super::ellipsoid::EquivalentEllipsoid;
 use super::form::{FormError, FormParameters};
@@ -20,7 +21,9 @@ pub struct Angularity {
     pub sphericity: f64,
     /// The same of its mass-equivalent ellipsoid.
     pub ellipsoid_sphericity: f64,
-    /// Mesh volume over that ellipsoid's volume.
+    /// Mesh volume over that ellipsoid's volume: 1 for an ellipsoid, which has the most volume
+    /// for its second moments, lower the more the bulk departs from one; a stretch along the
+    /// principal axes leaves it unchanged, so a mesh keeps it at every form it is rescaled to.
     pub volume_ratio: f64,
 }
 

@@ -1,7 +1,7 @@
 //! Seeded convex "pebble" meshes for users without grain scans: the convex hull of a point
-//! cloud on a lumpy ellipsoid, chipped by random planes so that the grain has the flat facets
-//! and edges of fluvial gravel rather than the smoothness of an ellipsoid, as angular at its
-//! form as the shipped Rhine scans.
+//! cloud on a lumpy, bent, rounded box, cut by one fracture face and chipped by a few planes,
+//! so that the grain deviates from the ellipsoid of its form in its bulk as well as in its
+//! facets and edges, as much as the shipped Rhine scans do.
 
 use nalgebra::Vector3;
 use rand::{RngExt, SeedableRng};
@@ -16,6 +16,14 @@ use super::simplify::{SimplifyError, simplify};
 /// keep within the bound unsimplified, loses the points chipped into a facet's interior and
 /// ends at 170–240 of 300 faces, and Table 4 has coarser meshes pack looser (~0.005 between
 /// ≤ 300 faces and the next coarser column).
+///
+/// The shape is matched to the two scans in what a packing sees once a grain is rescaled to a
+/// drawn form (`Angularity`, with the form removed): the relative sphericity at forms drawn from
+/// Table 2 and the volume over that of the mass-equivalent ellipsoid, which no rescaling
+/// changes. Pebbles that were an ellipsoid chipped by 8–13 shallow planes had the scans'
+/// sphericity but 0.967 of the ellipsoid's volume against the scans' 0.922 and 0.961: all of
+/// their angularity in facets, none in their bulk, and they packed Table 6's U1 0.014 looser
+/// than the scans rescaled to the same forms.
 pub fn pebble(seed: u64, max_faces: usize) -> Result<TriMesh, SimplifyError> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let points = 2 * (max_faces.max(8) + 4);
@@ -24,38 +32,42 @@ pub fn pebble(seed: u64, max_faces: usize) -> Result<TriMesh, SimplifyError> {
     let (fl, el) = forms.sample_flatness_elongation(&mut rng);
     let semi_axes = Vector3::new(1.0, el, el * fl);
 
+    // A rounded box (superellipsoid exponent above the ellipsoid's 2): gravel is blockier than
+    // an ellipsoid of its form.
+    let exponent = rng.random_range(2.8..4.0);
     // Smooth lumps: a few broad bumps and dents of the radius.
     let lumps: Vec<(Vector3<f64>, f64)> =
         (0..6).map(|_| (random_direction(&mut rng), rng.random_range(-0.12..0.12))).collect();
-    // Chips: planes that cut off caps, leaving flat facets; offsets as fractions of the support.
-    // This many, this deep, make pebbles as angular as the Rhine scans (their sphericity over
-    // that of the ellipsoid of their form, `Angularity`: 0.945 ± 0.008 for the 20 of
-    // builtin:pebbles against 0.938 and 0.954 for the two scans; 4–8 chips at 0.72–0.92 gave
-    // 0.968 ± 0.005, grains rounder than the scans at the same form; the denser cloud sharpens
-    // the chips' edges, so they cut less deep than the 0.62–0.86 of a cloud of 152 points).
-    let chips: Vec<(Vector3<f64>, f64)> =
-        (0..rng.random_range(8..14)).map(|_| (random_direction(&mut rng), rng.random_range(0.66..0.88))).collect();
+    // Bent along its long axis, one end drooping in y and z by up to a quarter of L/2.
+    let bend = Vector3::new(0.0, rng.random_range(-0.25..0.25), rng.random_range(-0.25..0.25));
+    // Planes as (normal, offset as a fraction of the support): one deep fracture face, then
+    // 2–4 shallow chips that leave small facets and edges.
+    let mut cuts = vec![(random_direction(&mut rng), rng.random_range(0.5..0.7))];
+    for _ in 0..rng.random_range(2..5) {
+        cuts.push((random_direction(&mut rng), rng.random_range(0.78..0.94)));
+    }
 
     let cloud: Vec<Vector3<f64>> = (0..points)
         .map(|_| {
             let u = random_direction(&mut rng);
             let lump: f64 = lumps.iter().map(|(c, a)| a * (4.0 * (u.dot(c) - 1.0)).exp()).sum();
-            let mut p = (1.0 + lump + rng.random_range(-0.02..0.02)) * u.component_mul(&semi_axes);
-            for (n, offset) in &chips {
+            let on_box = u / (u.iter().map(|c| c.abs().powf(exponent)).sum::<f64>()).powf(1.0 / exponent);
+            let mut p = (1.0 + lump + rng.random_range(-0.02..0.02)) * on_box.component_mul(&semi_axes);
+            p += bend * p.x * p.x;
+            for (n, offset) in &cuts {
                 let support = n.component_mul(&semi_axes).norm();
                 let excess = p.dot(n) - offset * support;
                 if excess > 0.0 {
                     p -= excess * n;
                 }
             }
-            // A tiny jitter keeps chipped points off exact coplanarity, which quickhull dislikes.
+            // A tiny jitter keeps cut points off exact coplanarity, which quickhull dislikes.
             p + 1e-5 * random_direction(&mut rng)
         })
         .collect();
     let hull = TriMesh::convex_hull(&cloud).map_err(SimplifyError::Defect)?;
     Ok(simplify(&hull, max_faces.max(4))?.mesh)
 }
-
 /// `count` pebbles from one seed: pebble k uses seed·1,000,003 + k.
 pub fn pebble_library(count: usize, seed: u64, max_faces: usize) -> Result<Vec<TriMesh>, SimplifyError> {
     (0..count as u64).map(|k| pebble(seed.wrapping_mul(1_000_003).wrapping_add(k), max_faces)).collect()
