@@ -22,7 +22,7 @@ use super::simplify::{SimplifyError, simplify};
 /// Table 2 and the volume over that of the mass-equivalent ellipsoid, which no rescaling
 /// changes. Pebbles that were an ellipsoid chipped by 8–13 shallow planes had the scans'
 /// sphericity but 0.967 of the ellipsoid's volume against the scans' 0.922 and 0.961: all of
-/// their angularity in facets, none in their bulk, and they packed Table 6's U1 0.014 looser
+/// their angularity in facets, none in their bulk, and they packed Table 6's U1 0.015 looser
 /// than the scans rescaled to the same forms.
 pub fn pebble(seed: u64, max_faces: usize) -> Result<TriMesh, SimplifyError> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -68,6 +68,7 @@ pub fn pebble(seed: u64, max_faces: usize) -> Result<TriMesh, SimplifyError> {
     let hull = TriMesh::convex_hull(&cloud).map_err(SimplifyError::Defect)?;
     Ok(simplify(&hull, max_faces.max(4))?.mesh)
 }
+
 /// `count` pebbles from one seed: pebble k uses seed·1,000,003 + k.
 pub fn pebble_library(count: usize, seed: u64, max_faces: usize) -> Result<Vec<TriMesh>, SimplifyError> {
     (0..count as u64).map(|k| pebble(seed.wrapping_mul(1_000_003).wrapping_add(k), max_faces)).collect()
