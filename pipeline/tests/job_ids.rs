@@ -373,6 +373,36 @@ fn the_pebbles_with_drawn_forms_are_the_cylinders_rhine_forms_but_for_the_librar
 }
 
 #[test]
+fn fig_10_under_the_witness_is_the_single_form_study_with_only_the_contact_point_changed() {
+    use solver::dem::ContactPoint;
+    let study = read("campaigns/validation-single-forms-witness.yaml");
+    let centre = read("campaigns/validation-single-forms.yaml");
+    assert_eq!((study.jobs.len(), centre.jobs.len()), (30, 30));
+    for (witness, centre) in study.jobs.iter().zip(&centre.jobs) {
+        let mut same = witness.spec.packing.clone();
+        assert_eq!(same.contact_point, ContactPoint::Witness);
+        same.contact_point = ContactPoint::CentreOfPressure;
+        assert_eq!(same, centre.spec.packing, "seed {}", same.seed);
+        assert_eq!(witness.parameters, centre.parameters);
+    }
+}
+
+#[test]
+fn the_pebbles_with_drawn_forms_in_table_7s_u7_are_its_rhine_forms_shaken_1_s_but_for_the_library() {
+    let pebbles = read("campaigns/validation-pebbles-periodic-rhine-forms.yaml");
+    let scans = read("campaigns/validation-rhine-forms-u7-shaken-1s.yaml");
+    assert_eq!((pebbles.jobs.len(), scans.jobs.len()), (3, 3));
+    for (pebble, scan) in pebbles.jobs.iter().zip(&scans.jobs) {
+        let library = pebble.spec.packing.grains.meshes.as_ref().unwrap();
+        assert_eq!((library.source.as_str(), library.faces), ("builtin:pebbles", 300));
+        let mut same = pebble.spec.packing.clone();
+        same.grains.meshes = scan.spec.packing.grains.meshes.clone();
+        assert_eq!(&same, &scan.spec.packing, "differs by more than the library, seed {}", scan.spec.packing.seed);
+        assert_ne!(pebble.id, scan.id);
+    }
+}
+
+#[test]
 fn the_periodic_pebble_studies_are_table_11_and_table_7s_u7_poured_from_the_pebbles() {
     use solver::packing::FormSpec;
     let table11 = read("campaigns/validation-rhine-forms.yaml");
