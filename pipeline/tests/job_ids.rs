@@ -7,7 +7,7 @@
 mod common;
 
 use common::{fixture, repo};
-use sedpack::campaign::Campaign;
+use sedpack::campaign::{Campaign, PlannedJob};
 use serde_json::Value;
 
 /// A campaign file of the repository, read as `sedpack run` reads it.
@@ -356,17 +356,29 @@ fn the_cylinders_rhine_forms_study_is_table_6s_u1_and_u7_under_the_witness_but_f
     }
 }
 
-#[test]
-fn the_pebbles_with_drawn_forms_are_the_cylinders_rhine_forms_but_for_the_library() {
-    let pebbles = read("campaigns/validation-pebbles-cylinder-rhine-forms.yaml");
-    let scans = read("campaigns/validation-cylinder-rhine-forms.yaml");
-    assert_eq!((pebbles.jobs.len(), scans.jobs.len()), (6, 6));
+/// The jobs of `pebbles` and `scans`, paired, after asserting that each pair differs only in
+/// the library (the pebbles, simplified to 300 faces as the scans are).
+fn only_the_library_differs(pebbles: &str, scans: &str, jobs: usize) -> Vec<(PlannedJob, PlannedJob)> {
+    let (pebbles, scans) = (read(pebbles), read(scans));
+    assert_eq!((pebbles.jobs.len(), scans.jobs.len()), (jobs, jobs));
     for (pebble, scan) in pebbles.jobs.iter().zip(&scans.jobs) {
         let library = pebble.spec.packing.grains.meshes.as_ref().unwrap();
         assert_eq!((library.source.as_str(), library.faces), ("builtin:pebbles", 300));
         let mut same = pebble.spec.packing.clone();
         same.grains.meshes = scan.spec.packing.grains.meshes.clone();
         assert_eq!(&same, &scan.spec.packing, "differs by more than the library, seed {}", scan.spec.packing.seed);
+    }
+    pebbles.jobs.into_iter().zip(scans.jobs).collect()
+}
+
+#[test]
+fn the_pebbles_with_drawn_forms_are_the_cylinders_rhine_forms_but_for_the_library() {
+    let pairs = only_the_library_differs(
+        "campaigns/validation-pebbles-cylinder-rhine-forms.yaml",
+        "campaigns/validation-cylinder-rhine-forms.yaml",
+        6,
+    );
+    for (pebble, scan) in pairs {
         assert_eq!(pebble.parameters, scan.parameters);
         assert!(pebble.spec.experiment.is_some());
     }
@@ -389,15 +401,12 @@ fn fig_10_under_the_witness_is_the_single_form_study_with_only_the_contact_point
 
 #[test]
 fn the_pebbles_with_drawn_forms_in_table_7s_u7_are_its_rhine_forms_shaken_1_s_but_for_the_library() {
-    let pebbles = read("campaigns/validation-pebbles-periodic-rhine-forms.yaml");
-    let scans = read("campaigns/validation-rhine-forms-u7-shaken-1s.yaml");
-    assert_eq!((pebbles.jobs.len(), scans.jobs.len()), (3, 3));
-    for (pebble, scan) in pebbles.jobs.iter().zip(&scans.jobs) {
-        let library = pebble.spec.packing.grains.meshes.as_ref().unwrap();
-        assert_eq!((library.source.as_str(), library.faces), ("builtin:pebbles", 300));
-        let mut same = pebble.spec.packing.clone();
-        same.grains.meshes = scan.spec.packing.grains.meshes.clone();
-        assert_eq!(&same, &scan.spec.packing, "differs by more than the library, seed {}", scan.spec.packing.seed);
+    let pairs = only_the_library_differs(
+        "campaigns/validation-pebbles-periodic-rhine-forms.yaml",
+        "campaigns/validation-rhine-forms-u7-shaken-1s.yaml",
+        3,
+    );
+    for (pebble, scan) in pairs {
         assert_ne!(pebble.id, scan.id);
     }
 }
