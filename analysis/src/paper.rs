@@ -95,23 +95,28 @@ pub struct PaperPorosity {
     pub std: Option<f64>,
 }
 
-/// One simulated setup of Tables 5–8 and 11: domain, width L (m), total mass (kg), shaking
-/// duration t_s (s), Table 3 case and the meshes' forms, with the porosity found.
-struct Simulated {
-    table: &'static str,
+/// A setup the paper simulated: domain, width L (m), total mass (kg), shaking duration t_s (s),
+/// Table 3 case and the grains' forms.
+struct Setup {
     kind: DomainKind,
     width: f64,
     mass: f64,
     shaking: f64,
     case: &'static str,
     form: FormSpec,
+}
+
+/// One simulated setup of Tables 5–8 and 11 with the porosity found.
+struct Simulated {
+    table: &'static str,
+    setup: Setup,
     porosity: f64,
     std: Option<f64>,
 }
 
 const fn cylinder(table: &'static str, shaking: f64, case: &'static str, porosity: f64, std: f64) -> Simulated {
-    let (std, form) = (Some(std), FormSpec::Own);
-    Simulated { table, kind: DomainKind::Cylinder, width: 0.104, mass: 3.0, shaking, case, form, porosity, std }
+    let setup = Setup { kind: DomainKind::Cylinder, width: 0.104, mass: 3.0, shaking, case, form: FormSpec::Own };
+    Simulated { table, setup, porosity, std: Some(std) }
 }
 
 const fn periodic(
@@ -123,24 +128,16 @@ const fn periodic(
     porosity: f64,
     std: Option<f64>,
 ) -> Simulated {
-    let form = FormSpec::Own;
-    Simulated { table, kind: DomainKind::Periodic, width, mass, shaking, case, form, porosity, std }
+    let setup = Setup { kind: DomainKind::Periodic, width, mass, shaking, case, form: FormSpec::Own };
+    Simulated { table, setup, porosity, std }
 }
 
 /// Table 11's "continuous" setup: the periodic default (0.2 m, 16 kg, t_s = 6 s) with the forms
 /// drawn from the Rhine distribution of Table 2.
 const fn rhine_forms(case: &'static str, porosity: f64) -> Simulated {
-    Simulated {
-        table: "Table 11",
-        kind: DomainKind::Periodic,
-        width: 0.2,
-        mass: 16.0,
-        shaking: 6.0,
-        case,
-        form: FormSpec::Distribution(RHINE_FORMS),
-        porosity,
-        std: None,
-    }
+    let form = FormSpec::Distribution(RHINE_FORMS);
+    let setup = Setup { kind: DomainKind::Periodic, width: 0.2, mass: 16.0, shaking: MODEL_SHAKING, case, form };
+    Simulated { table: "Table 11", setup, porosity, std: None }
 }
 
 /// Tables 5–8 and 11 as printed. Where two tables give the same setup (t_s = 1 s in Tables 5
@@ -197,8 +194,8 @@ const SIMULATED: [Simulated; 32] = [
 /// or the software's close-packed one) may differ.
 pub fn simulated_porosity(spec: &PackingSpec) -> Option<PaperPorosity> {
     let case = spec.grains.size.case()?.name;
-    let row = SIMULATED.iter().find(|s| row_differences(s, spec, case).is_empty())?;
-    follows_papers_protocol(spec, row.form).then(|| PaperPorosity {
+    let row = SIMULATED.iter().find(|s| row_differences(&s.setup, spec, case).is_empty())?;
+    follows_papers_protocol(spec, row.setup.form).then(|| PaperPorosity {
         table: row.table.to_string(),
         porosity: row.porosity,
         std: row.std,
@@ -211,7 +208,7 @@ fn domain_kind(spec: &PackingSpec) -> DomainKind {
 
 /// What of domain, width, mass, t_s, Table 3 case (`case`, the spec's) and forms `spec` has
 /// apart from `row`, in words; empty when it is the row's setup.
-fn row_differences(row: &Simulated, spec: &PackingSpec, case: &str) -> Vec<String> {
+fn row_differences(row: &Setup, spec: &PackingSpec, case: &str) -> Vec<String> {
     let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b.abs().max(1.0);
     let mut words = Vec::new();
     if row.kind != domain_kind(spec) {
@@ -287,7 +284,8 @@ pub struct NearestSetup {
 
 /// Why a packing that is none of the paper's simulated setups (`simulated_porosity` gives
 /// None) is not: the nearest row of Tables 5–8 and 11 (fewest of domain, width, mass, t_s,
-/// Table 3 case and forms apart) and what differs from it, the protocol's keys included.
+/// Table 3 case and forms apart) or, for one form of U1, U7 or B50, §6's single-form packings
+/// (in no table), and what differs from it, the protocol's keys included.
 pub fn nearest_papers_setup(spec: &PackingSpec) -> NearestSetup {
     let Some(case) = spec.grains.size.case().map(|c| c.name) else {
         let differences =
@@ -295,9 +293,23 @@ pub fn nearest_papers_setup(spec: &PackingSpec) -> NearestSetup {
                 .into();
         return NearestSetup { setup: None, differences };
     };
-    let row = SIMULATED.iter().min_by_key(|s| row_differences(s, spec, case).len()).expect("the tables have rows");
+    let single_form = single_form_study(spec, case);
+    let (name, row) = match &single_form {
+        Some((_, setup)) => (format!("§6's single-form {case} packings"), setup),
+        None => {
+            let row = SIMULATED
+                .iter()
+                .min_by_key(|s| row_differences(&s.setup, spec, case).len())
+                .expect("the tables have rows");
+            (format!("{}'s {}", row.table, row.setup.case), &row.setup)
+        }
+    };
     // The forms are judged against the row above; the protocol is the rest.
-    let (papers, rules) = papers_protocol(spec, spec.grains.form);
+    let (mut papers, rules) = papers_protocol(spec, spec.grains.form);
+    if single_form.is_some() && spec.grains.shape == ShapeKind::Ellipsoid {
+        // §6.4 packed each form as a mesh and as its form-equivalent ellipsoid.
+        papers.grains.shape = ShapeKind::Ellipsoid;
+    }
     let mut keys = Vec::new();
     let to_value = |s: &PackingSpec| serde_json::to_value(s).expect("a spec is JSON");
     differing_keys("", &to_value(&papers), &to_value(spec), &mut keys);
@@ -316,17 +328,32 @@ pub fn nearest_papers_setup(spec: &PackingSpec) -> NearestSetup {
     if !keys.is_empty() {
         differences.push(format!("it departs from the paper's protocol in {}", keys.join(", ")));
     }
+    let forms = match &single_form {
+        Some((equation, _)) => format!(
+            "one form per packing, a scan's or its equivalent ellipsoid's; their porosities are given only as Fig. 10's points and {equation}"
+        ),
+        None => form_words(row.form),
+    };
     let setup = format!(
-        "{}'s {} ({}, L = {} m, {} kg, t_s = {} s, {})",
-        row.table,
-        row.case,
+        "{name} ({}, L = {} m, {} kg, t_s = {} s, {forms})",
         domain_words(row.kind),
         row.width,
         row.mass,
         row.shaking,
-        form_words(row.form)
     );
     NearestSetup { setup: Some(setup), differences: differences.join("; ") }
+}
+
+/// The single-form packings of §6 (Fig. 10, Eqs. 17–19), when `spec` has one form and its
+/// Table 3 case (`case`) is one §6 packed: the equation fitted to them and their setup, the
+/// setting of the paper's models (L = 0.2 m, 16 kg, t_s = 6 s) with `spec`'s form.
+fn single_form_study(spec: &PackingSpec, case: &'static str) -> Option<(String, Setup)> {
+    let FormSpec::Single { .. } = spec.grains.form else {
+        return None;
+    };
+    let equation = paper_model(&format!("paper-sf-{case}"))?.model.campaign?.replace("Rettinger et al. (2022), ", "");
+    let form = spec.grains.form;
+    Some((equation, Setup { kind: DomainKind::Periodic, width: 0.2, mass: 16.0, shaking: MODEL_SHAKING, case, form }))
 }
 
 fn domain_words(kind: DomainKind) -> &'static str {
@@ -577,6 +604,38 @@ mod tests {
         let mut custom = table7("U7");
         custom.grains.size = solver::grain::SieveCurve::new(vec![0.01, 0.02], vec![1.0]).unwrap();
         assert_eq!(nearest_papers_setup(&custom).setup, None);
+    }
+
+    #[test]
+    fn a_single_form_packing_is_told_the_single_form_study_of_section_6_in_no_table() {
+        // Fig. 10 scaled down like validation-single-forms: U1 in 0.04 m, 0.64 kg, one form.
+        let single = |shape, case: usize| {
+            let mut spec = table11();
+            (spec.domain, spec.grains.mass) = (Domain::Periodic { width: 0.04 }, 0.64);
+            spec.grains.size = TABLE3[case].sieve_curve();
+            (spec.grains.shape, spec.grains.form) = (shape, FormSpec::Single { fl: 0.53, el: 0.53 });
+            assert_eq!(found(&spec), None);
+            nearest_papers_setup(&spec)
+        };
+        let study = "§6's single-form U1 packings (periodic domain, L = 0.2 m, 16 kg, t_s = 6 s, one form per packing, a scan's or its equivalent ellipsoid's; their porosities are given only as Fig. 10's points and Eq. 17)";
+        // §6.4 packed every form both as a mesh and as its ellipsoid: neither departs.
+        for shape in [ShapeKind::Mesh, ShapeKind::Ellipsoid] {
+            let nearest = single(shape, 0);
+            assert_eq!(nearest.setup.as_deref(), Some(study), "{shape:?}");
+            assert_eq!(nearest.differences, "this setup has L = 0.04 m, 0.64 kg", "{shape:?}");
+        }
+        let spheres = single(ShapeKind::Sphere, 0);
+        assert_eq!(
+            spheres.differences,
+            "this setup has L = 0.04 m, 0.64 kg; it departs from the paper's protocol in grains.shape"
+        );
+        // B50 has its own single-form model (Eq. 19); U3 (TABLE3[1]) was not packed in single
+        // forms, so the nearest is a table's row.
+        let b50 = TABLE3.iter().position(|c| c.name == "B50").unwrap();
+        assert!(single(ShapeKind::Mesh, b50).setup.unwrap().ends_with("Fig. 10's points and Eq. 19)"));
+        assert_eq!(TABLE3[1].name, "U3");
+        let u3 = single(ShapeKind::Mesh, 1).setup.unwrap();
+        assert!(u3.starts_with("Table ") && !u3.contains("Fig. 10"), "{u3}");
     }
 
     /// The paper's periodic setting of its models (t_s = 6 s) with meshes of the Rhine form

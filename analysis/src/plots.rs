@@ -5,6 +5,7 @@
 
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use solver::porosity::ProfilePoint;
@@ -267,7 +268,7 @@ pub fn series_with_spread(title: &str, x_label: &str, y_label: &str, series: &[S
                 chart
                     .draw_series(DashedLineSeries::new(line, 6, 4, colour.stroke_width(2)))?
                     .label(s.label.as_str())
-                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], colour.stroke_width(2)));
+                    .legend(move |(x, y)| DashedPathElement::new([(x, y), (x + 16, y)], 6, 4, colour.stroke_width(2)));
                 continue;
             }
             chart.draw_series(LineSeries::new(points.iter().map(|p| (p.0, p.1)), colour.stroke_width(1)))?;
@@ -435,6 +436,22 @@ mod tests {
         // the two points.
         assert_eq!(elements(&measured, "polyline", stroke), 1, "{measured}");
         assert!(elements(&model, "polyline", stroke) > 30, "{model}");
+        // The legend's symbol, the only horizontal stroke (the curve rises): dashed like the
+        // curve, so more than one piece, each shorter than the 16 px of a solid symbol.
+        let horizontal: Vec<i32> = model
+            .split('<')
+            .filter(|e| e.starts_with("polyline") && e.contains(stroke))
+            .filter_map(|e| {
+                let points = e.split("points=\"").nth(1)?.split('"').next()?;
+                let xy: Vec<(i32, i32)> = points
+                    .split_whitespace()
+                    .filter_map(|p| p.split_once(',').map(|(x, y)| (x.parse().unwrap(), y.parse().unwrap())))
+                    .collect();
+                let (first, last) = (xy.first()?, xy.last()?);
+                (first.1 == last.1).then_some(last.0 - first.0)
+            })
+            .collect();
+        assert!(horizontal.len() > 1 && horizontal.iter().all(|&l| l < 16), "{horizontal:?}");
     }
 
     #[test]

@@ -429,7 +429,7 @@ fn paper_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
         "The other setups are none of the paper's simulated setups; the nearest of those to each, and what differs:"
     } else {
         blocks.push(Block::Heading("Comparison with the paper's simulations".into()));
-        "No setup of this campaign is one of the paper's simulated setups (Tables 5–8 and 11, each by the paper's protocol: see the README's \"sedpack report\"), so there is nothing of the paper's to set its porosity beside. The nearest of the paper's setups to each, and what differs:"
+        "No setup of this campaign is one of the paper's simulated setups with a porosity in its tables (Tables 5–8 and 11, each by the paper's protocol: see the README's \"sedpack report\"), so there is no table value to set its porosity beside. The nearest of the paper's setups to each, and what differs:"
     };
     blocks.push(Block::Paragraph(intro.into()));
     // Setups told the same are one row: a grid over forms is one answer, not one per form.
