@@ -145,6 +145,14 @@ pub struct ZinggPacking {
     pub std_fl: f64,
 }
 
+impl ZinggPacking {
+    /// Whether its ellipse shows: a semi-axis of σ ≥ 0.002 is a pixel or more of the diagram's
+    /// ~480 px axes (a single-form packing's σ is zero up to rounding).
+    pub fn has_spread(&self) -> bool {
+        self.std_el.max(self.std_fl) >= 0.002
+    }
+}
+
 /// Zingg diagram like Fig. 11: EL on x, FL on y, the class boundaries at 2/3, each packing's
 /// mean as a point and its standard deviations as the semi-axes of an ellipse.
 pub fn zingg_diagram(packings: &[ZinggPacking]) -> Result<String, PlotError> {
@@ -188,13 +196,16 @@ pub fn zingg_diagram(packings: &[ZinggPacking]) -> Result<String, PlotError> {
                 })
                 .collect()
         };
-        chart.draw_series(packings.iter().map(|p| PathElement::new(ellipse(p), STEEL.mix(0.7).stroke_width(1))))?;
+        let spread: Vec<&ZinggPacking> = packings.iter().filter(|p| p.has_spread()).collect();
+        chart.draw_series(spread.iter().map(|p| PathElement::new(ellipse(p), STEEL.mix(0.7).stroke_width(1))))?;
         chart.draw_series(packings.iter().map(|p| Circle::new((p.mean_el, p.mean_fl), 4, ORANGE.filled())))?;
         let left = TextStyle::from((FONT, 13).into_font()).pos(Pos::new(HPos::Left, VPos::Center));
         lower.draw(&Circle::new((90, 18), 4, ORANGE.filled()))?;
         lower.draw(&Text::new("packing mean (μ_EL, μ_FL)", (100, 18), left.clone()))?;
-        lower.draw(&Circle::new((330, 18), 7, STEEL.stroke_width(1)))?;
-        lower.draw(&Text::new("standard deviations as semi-axes", (343, 18), left))?;
+        if !spread.is_empty() {
+            lower.draw(&Circle::new((330, 18), 7, STEEL.stroke_width(1)))?;
+            lower.draw(&Text::new("standard deviations as semi-axes", (343, 18), left))?;
+        }
         Ok(())
     })
 }
@@ -452,6 +463,20 @@ mod tests {
             })
             .collect();
         assert!(horizontal.len() > 1 && horizontal.iter().all(|&l| l < 16), "{horizontal:?}");
+    }
+
+    #[test]
+    fn a_zingg_diagram_draws_ellipses_and_their_legend_only_for_packings_with_a_spread() {
+        let single = ZinggPacking { mean_el: 0.53, std_el: 1e-17, mean_fl: 0.53, std_fl: 0.0 };
+        let mixture = ZinggPacking { mean_el: 0.68, std_el: 0.14, mean_fl: 0.65, std_fl: 0.17 };
+        let ellipses =
+            |svg: &str| svg.split('<').filter(|e| e.starts_with("polyline") && e.contains("#285AAA")).count();
+        let one_form = zingg_diagram(&[single, single]).unwrap();
+        assert_eq!(ellipses(&one_form), 0, "{one_form}");
+        assert!(!one_form.contains("standard deviations"), "{one_form}");
+        let both = zingg_diagram(&[single, mixture]).unwrap();
+        assert_eq!(ellipses(&both), 1, "{both}");
+        assert!(both.contains("standard deviations as semi-axes"), "{both}");
     }
 
     #[test]

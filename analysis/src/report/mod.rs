@@ -303,11 +303,12 @@ fn packings_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<()
             Some(ZinggPacking { mean_el: el.0, std_el: el.1, mean_fl: fl.0, std_fl: fl.1 })
         })
         .collect();
-    blocks.push(Block::Figure {
-        file: "zingg".into(),
-        caption: "Zingg diagram (like Fig. 11): each packing's mean elongation and flatness as a point, the standard deviations as the semi-axes of an ellipse; dashed lines are the class boundaries at 2/3.".into(),
-        svg: plots::zingg_diagram(&zingg)?,
-    });
+    let caption = if zingg.iter().any(ZinggPacking::has_spread) {
+        "Zingg diagram (like Fig. 11): each packing's mean elongation and flatness as a point, the standard deviations as the semi-axes of an ellipse; dashed lines are the class boundaries at 2/3."
+    } else {
+        "Zingg diagram (like Fig. 11): each packing's elongation and flatness as a point (all grains of a packing have one form: no spread to draw); dashed lines are the class boundaries at 2/3."
+    };
+    blocks.push(Block::Figure { file: "zingg".into(), caption: caption.into(), svg: plots::zingg_diagram(&zingg)? });
     let profiles: Vec<(String, Vec<_>)> =
         records.iter().zip(ids).filter(|(r, _)| !r.profile.is_empty()).map(|(r, id)| (id, r.profile.clone())).collect();
     if !profiles.is_empty() {
