@@ -26,6 +26,14 @@ pub struct PaperModel {
     pub model: LinearModel,
 }
 
+/// The source a paper model names as its campaign, before its equation.
+const SOURCE: &str = "Rettinger et al. (2022), ";
+
+/// The equation a paper model is ("Eq. 17", …), from the campaign it names.
+pub fn paper_equation(model: &LinearModel) -> String {
+    model.campaign.as_deref().unwrap_or_default().replace(SOURCE, "")
+}
+
 fn model(
     name: &str,
     equation: &str,
@@ -41,7 +49,7 @@ fn model(
         intercept,
         cv,
         ranges: BTreeMap::new(),
-        campaign: Some(format!("Rettinger et al. (2022), {equation}")),
+        campaign: Some(format!("{SOURCE}{equation}")),
     }
 }
 
@@ -135,9 +143,18 @@ const fn periodic(
 /// Table 11's "continuous" setup: the periodic default (0.2 m, 16 kg, t_s = 6 s) with the forms
 /// drawn from the Rhine distribution of Table 2.
 const fn rhine_forms(case: &'static str, porosity: f64) -> Simulated {
-    let form = FormSpec::Distribution(RHINE_FORMS);
-    let setup = Setup { kind: DomainKind::Periodic, width: 0.2, mass: 16.0, shaking: MODEL_SHAKING, case, form };
-    Simulated { table: "Table 11", setup, porosity, std: None }
+    Simulated {
+        table: "Table 11",
+        setup: model_setting(case, FormSpec::Distribution(RHINE_FORMS)),
+        porosity,
+        std: None,
+    }
+}
+
+/// The setup of the packings the paper fitted its models to (§6.1–6.2): the periodic domain, L =
+/// 0.2 m, 16 kg, t_s = 6 s, of `case` with `form`.
+const fn model_setting(case: &'static str, form: FormSpec) -> Setup {
+    Setup { kind: DomainKind::Periodic, width: 0.2, mass: 16.0, shaking: MODEL_SHAKING, case, form }
 }
 
 /// Tables 5–8 and 11 as printed. Where two tables give the same setup (t_s = 1 s in Tables 5
@@ -346,14 +363,13 @@ pub fn nearest_papers_setup(spec: &PackingSpec) -> NearestSetup {
 
 /// The single-form packings of §6 (Fig. 10, Eqs. 17–19), when `spec` has one form and its
 /// Table 3 case (`case`) is one §6 packed: the equation fitted to them and their setup, the
-/// setting of the paper's models (L = 0.2 m, 16 kg, t_s = 6 s) with `spec`'s form.
+/// setting of the paper's models (`model_setting`) with `spec`'s form.
 fn single_form_study(spec: &PackingSpec, case: &'static str) -> Option<(String, Setup)> {
     let FormSpec::Single { .. } = spec.grains.form else {
         return None;
     };
-    let equation = paper_model(&format!("paper-sf-{case}"))?.model.campaign?.replace("Rettinger et al. (2022), ", "");
-    let form = spec.grains.form;
-    Some((equation, Setup { kind: DomainKind::Periodic, width: 0.2, mass: 16.0, shaking: MODEL_SHAKING, case, form }))
+    let equation = paper_equation(&paper_model(&format!("paper-sf-{case}"))?.model);
+    Some((equation, model_setting(case, spec.grains.form)))
 }
 
 fn domain_words(kind: DomainKind) -> &'static str {
@@ -455,7 +471,7 @@ pub fn model_porosity(spec: &PackingSpec, statistics: &BTreeMap<String, (f64, f6
             MIXTURE_SIGMAS[0]
         )
     });
-    let equation = paper.model.campaign.unwrap_or_default().replace("Rettinger et al. (2022), ", "");
+    let equation = paper_equation(&paper.model);
     Some(ModelPorosity { model: name, equation, porosity, caveat })
 }
 

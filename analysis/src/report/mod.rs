@@ -19,7 +19,7 @@ use crate::correlation::CorrelationMatrix;
 use crate::dataset::{Dataset, FeatureKind};
 use crate::form_factors::symbol;
 use crate::model::LinearModel;
-use crate::paper::{NearestSetup, paper_model};
+use crate::paper::{NearestSetup, paper_equation, paper_model};
 use crate::plots::{self, PlotError, ScatterPlot, ZinggPacking};
 use crate::record::{CampaignSummary, Cost, JobRecord};
 use crate::selection::{Candidate, Selection, SelectionOptions, set_label};
@@ -630,8 +630,7 @@ fn shape_section(blocks: &mut Vec<Block>, records: &[JobRecord]) -> Result<(), R
             paper.as_ref()?.predict(&values).ok()
         })
         .collect();
-    let equation =
-        paper.as_ref().map(|m| m.campaign.clone().unwrap_or_default().replace("Rettinger et al. (2022), ", ""));
+    let equation = paper.as_ref().map(paper_equation);
     blocks.push(Block::Heading("Grain shape at equal form (Fig. 10)".into()));
     let mut intro = format!(
         "Each setup's packings per grain shape: the mean inverse equancy L/S of their grains, and their porosity (mean ± population std over the seeds, runs in brackets; a single run shows its value alone). The differences are to the first shape, `{}`; RMS over the setups where both have runs (the paper finds ~0.008 between meshes and their equivalent ellipsoids).",
