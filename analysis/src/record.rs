@@ -1,11 +1,12 @@
 //! What the analysis reads: one plain record per finished job and a campaign summary. The
 //! pipeline maps store rows into these; the analysis never sees SQLite types, and of the solver
-//! only the porosity profile's points and the imbrication.
+//! only the porosity profile's points, the imbrication and the sieve classes as drawn.
 
 use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 use solver::fabric::Imbrication;
+use solver::grain::DrawnClass;
 use solver::porosity::ProfilePoint;
 
 use crate::paper::{ModelPorosity, NearestSetup, PaperPorosity};
@@ -47,6 +48,10 @@ pub struct JobRecord {
     pub fluid: Option<String>,
     /// The long axes' fabric against the flow, for packings that report one.
     pub imbrication: Option<Imbrication>,
+    /// Grains and mass created per sieve class, against the curve's fractions; empty for
+    /// results stored before sedpack recorded them.
+    #[serde(default)]
+    pub size_classes: Vec<DrawnClass>,
     /// The packing's setup in words, item → value (domain, grains, sieve curve, mass, shaking,
     /// contact point…), for the report's setup table.
     pub setup: Vec<(String, String)>,

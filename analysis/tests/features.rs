@@ -21,6 +21,7 @@ fn record(id: &str, porosity: f64, grains: &[(f64, f64)]) -> JobRecord {
         paper_model: None,
         fluid: None,
         imbrication: None,
+        size_classes: Vec::new(),
         setup: Vec::new(),
         cost: Cost::default(),
     }

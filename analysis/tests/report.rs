@@ -78,6 +78,7 @@ fn mixture_campaign() -> Vec<JobRecord> {
                         paper_model: None,
                         fluid: None,
                         imbrication: None,
+                        size_classes: Vec::new(),
                         setup: Vec::new(),
                         cost: Cost::default(),
                     });
@@ -261,6 +262,7 @@ fn validation_campaign() -> Vec<JobRecord> {
                 paper_model: None,
                 fluid: None,
                 imbrication: None,
+                size_classes: Vec::new(),
                 setup: Vec::new(),
                 // Seeds 1–3: 4,000, 4,010, 4,020 grains, 2.9–3.1 s simulated, 1, 2 and 1.5 h.
                 cost: Cost {
@@ -526,6 +528,7 @@ fn shape_records(size_case: Option<&str>) -> Vec<JobRecord> {
                 paper_model: None,
                 fluid: None,
                 imbrication: None,
+                size_classes: Vec::new(),
                 setup: Vec::new(),
                 cost: Cost::default(),
             });
@@ -628,6 +631,7 @@ fn a_campaign_with_and_without_drag_compares_them_seed_by_seed() {
                 paper_model: None,
                 fluid: fluid.map(String::from),
                 imbrication: None,
+                size_classes: Vec::new(),
                 setup: Vec::new(),
                 cost: Cost::default(),
             });
@@ -686,6 +690,7 @@ fn the_imbrication_of_each_setup_is_summed_over_its_runs() {
                 paper_model: None,
                 fluid: Some(fluid.into()),
                 imbrication: Some(f),
+                size_classes: Vec::new(),
                 setup: Vec::new(),
                 cost: Cost::default(),
             });
@@ -712,4 +717,62 @@ fn the_imbrication_of_each_setup_is_summed_over_its_runs() {
     assert!(md.contains("| all jobs | drag and lift, still water | 2 | 0.3700 | 0.0000 |\n"), "{md}");
     assert!(!md.contains("minus buoyancy only"), "{md}");
     check_html(out.path(), 0);
+}
+
+#[test]
+fn the_report_lists_each_graded_packings_sieve_classes_as_drawn_against_its_curve() {
+    use solver::grain::DrawnClass;
+    let class =
+        |lower: f64, upper: f64, asked: f64, grains: usize, mass: f64| DrawnClass { lower, upper, asked, grains, mass };
+    let mut records = validation_campaign();
+    for r in &mut records {
+        r.size_classes = match r.job_id.as_str() {
+            // U1 has one class: nothing to compare, not listed.
+            id if id.starts_with("U1") => vec![class(5.6e-3, 8e-3, 1.0, 4000, 3.0)],
+            "U3-0" => vec![
+                class(5.6e-3, 8e-3, 0.21, 2000, 0.6),
+                class(8e-3, 11.2e-3, 0.58, 1800, 1.8),
+                class(11.2e-3, 16e-3, 0.21, 200, 0.6),
+            ],
+            "U3-1" => vec![
+                class(5.6e-3, 8e-3, 0.21, 3000, 0.9),
+                class(8e-3, 11.2e-3, 0.58, 1500, 1.5),
+                class(11.2e-3, 16e-3, 0.21, 200, 0.6),
+            ],
+            // Stored by an earlier sedpack.
+            _ => Vec::new(),
+        };
+    }
+    let out = tempfile::tempdir().unwrap();
+    let files = report("validation", &records, out.path());
+    let md = std::fs::read_to_string(&files.markdown).unwrap();
+    let section = &md[md.find("## Sieve classes as drawn").expect(&md)..];
+    let section = &section[..section[3..].find("\n## ").map_or(section.len(), |k| k + 3)];
+    assert!(
+        section.contains(
+            "| job | `grains.size` | `seed` | grains | porosity n | 5.6–8 mm | 8–11.2 mm | 11.2–16 mm | off the curve |"
+        ),
+        "{section}"
+    );
+    // U3-0: 0.6, 1.8, 0.6 of 3 kg = 20, 60, 20 % against 21, 58, 21: (1 + 2 + 1)/2 = 2 % off.
+    // U3-1: 0.9, 1.5, 0.6 of 3 kg = 30, 50, 20 %: (9 + 8 + 1)/2 = 9 % off.
+    assert!(
+        section.contains("| `U3-0` | U3 | 1 | 4000 | 0.3670 | 20.0 (21) | 60.0 (58) | 20.0 (21) | 2.0 |"),
+        "{section}"
+    );
+    assert!(
+        section.contains("| `U3-1` | U3 | 2 | 4010 | 0.3690 | 30.0 (21) | 50.0 (58) | 20.0 (21) | 9.0 |"),
+        "{section}"
+    );
+    assert!(!section.contains("`U1-") && !section.contains("`U3-2`"), "{section}");
+    assert!(
+        section.contains("1 packing stored by an earlier sedpack, which did not record the classes, is not listed.")
+    );
+
+    // Without a graded packing there is no such section.
+    for r in &mut records {
+        r.size_classes.retain(|c| c.lower == 5.6e-3);
+    }
+    let files = report("validation", &records, out.path());
+    assert!(!std::fs::read_to_string(&files.markdown).unwrap().contains("Sieve classes as drawn"));
 }

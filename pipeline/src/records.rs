@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 use solver::dem::{Calibration, ContactPoint, Domain};
 use solver::fabric::Imbrication;
 use solver::fluid::flow::Flow;
+use solver::grain::DrawnClass;
 use solver::packing::{FormSpec, Grid, Orientation, PackingResult, PackingSpec, ShapeKind};
 use solver::porosity::ProfilePoint;
 use store::{CampaignStatus, ExportRow, GrainStatistic, JobResult, NewJob};
@@ -185,6 +186,7 @@ pub fn result_rows(result: &PackingResult) -> (JobResult, Vec<GrainStatistic>) {
         wall_time: result.wall_time.as_secs_f64(),
         solver_version: solver::VERSION.to_string(),
         imbrication: result.imbrication.as_ref().map(|i| serde_json::to_value(i).expect("numbers")),
+        size_classes: Some(serde_json::to_value(&result.size_classes).expect("numbers")),
     };
     let statistics = result
         .statistics
@@ -212,6 +214,13 @@ pub fn job_record(row: &ExportRow, spec: Option<&PackingSpec>) -> anyhow::Result
         .map(serde_json::from_value)
         .transpose()
         .with_context(|| format!("job {}: the stored imbrication is not sedpack's", row.job_id))?;
+    let size_classes: Vec<DrawnClass> = result
+        .size_classes
+        .clone()
+        .map(serde_json::from_value)
+        .transpose()
+        .with_context(|| format!("job {}: the stored size classes are not sedpack's", row.job_id))?
+        .unwrap_or_default();
     let grain_statistics: BTreeMap<_, _> =
         row.grain_statistics.iter().map(|s| (s.name.clone(), (s.mean, s.std))).collect();
     let paper = spec.and_then(simulated_porosity);
@@ -228,6 +237,7 @@ pub fn job_record(row: &ExportRow, spec: Option<&PackingSpec>) -> anyhow::Result
         grain_statistics,
         fluid: fluid.map(|f| f.describe()),
         imbrication,
+        size_classes,
         setup: spec.map(setup).unwrap_or_default(),
         cost: Cost { grains: result.particles, simulated_time: result.simulated_time, wall_time: result.wall_time },
     }))
@@ -336,6 +346,7 @@ mod tests {
                 wall_time: 1.0,
                 solver_version: "0.1.0".into(),
                 imbrication: None,
+                size_classes: None,
             }),
             grain_statistics: vec![GrainStatistic { name: "FL".into(), mean: 0.6, std: 0.05 }],
         }

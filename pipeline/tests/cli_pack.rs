@@ -33,6 +33,13 @@ fn pack_writes_consistent_outputs_that_the_porosity_command_confirms() {
     assert!((0.3..0.5).contains(&n), "porosity {n}");
     assert_eq!(file["experiment"]["porosity"], 0.4);
     assert!(file["statistics"]["mean_FL"] == 1.0 && file["statistics"]["std_EL"] == 0.0, "spheres: FL = EL = 1");
+    // One sieve class, holding every grain and all the mass created: the 0.1 kg asked, passed by
+    // less than the last grain drawn (at most an 8 mm sphere, 0.71 g).
+    let classes = file["size_classes"].as_array().unwrap();
+    assert_eq!(classes.len(), 1);
+    assert_eq!((classes[0]["lower"].as_f64(), classes[0]["asked"].as_f64()), (Some(0.0056), Some(1.0)));
+    assert_eq!(classes[0]["grains"], file["particles"]);
+    assert!((0.1..0.1 + 7.2e-4).contains(&classes[0]["mass"].as_f64().unwrap()), "{classes:?}");
 
     // particles.csv → x,y,z,r → `sedpack porosity` with the pack's trim (the largest sieve,
     // 8 mm) must give the same bulk porosity: the evaluation is one rule (§4.4) from two inputs.

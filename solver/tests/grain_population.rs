@@ -255,3 +255,22 @@ fn generated_pebbles_are_as_angular_as_the_rhine_scans_in_their_facets_and_their
     // Every pebble is more angular than an ellipsoid by more than a fine mesh of one is.
     assert!(pebbles.iter().all(|a| a.relative_sphericity() < 0.97), "{pebbles:?}");
 }
+
+#[test]
+fn a_packings_grains_are_counted_and_weighed_per_sieve_class_of_their_curve() {
+    let u3 = SieveCurve::preset("U3").unwrap();
+    // Two grains in 5.6–8 mm, one in 8–11.2 mm, none in 11.2–16 mm (asked 0.21), one in
+    // 2.8–4 mm (asked 0: still listed, as it holds a grain).
+    let drawn = u3.drawn([(2, 1e-3), (3, 4e-3), (2, 2e-3), (0, 5e-4)]);
+    let rows: Vec<(f64, f64, f64, usize, f64)> =
+        drawn.iter().map(|c| (c.lower, c.upper, c.asked, c.grains, c.mass)).collect();
+    assert_eq!(
+        rows,
+        [
+            (2.8e-3, 4.0e-3, 0.0, 1, 5e-4),
+            (5.6e-3, 8.0e-3, 0.21, 2, 3e-3),
+            (8.0e-3, 11.2e-3, 0.58, 1, 4e-3),
+            (11.2e-3, 16.0e-3, 0.21, 0, 0.0),
+        ]
+    );
+}

@@ -84,3 +84,34 @@ fn the_shaking_lasts_t_s_from_the_last_set_of_grains_and_progress_says_when_it_e
     let steps = (last - first + 1) as f64;
     assert!((steps - t_s / dt).abs() <= 1.0, "{steps} steps of {dt} s");
 }
+
+#[test]
+fn a_packing_reports_the_grains_and_mass_it_drew_in_each_sieve_class() {
+    use solver::grain::SieveCurve;
+    let mut spec = spec(0.5, 0.02, 3);
+    spec.grains.size = SieveCurve::new(vec![2.8e-3, 4e-3, 5.6e-3, 8e-3], vec![0.5, 0.0, 0.5]).unwrap();
+    spec.grains.mass = 0.05;
+    spec.trim = Some(4e-3);
+    let density = spec.material.density;
+    let mut packing = Packing::new(spec).unwrap();
+    while packing.advance(50_000).unwrap() != Phase::Converged {}
+    let result = packing.result().unwrap();
+    // The empty middle class is left out; the others keep their sieves and asked fractions.
+    let classes: Vec<(f64, f64, f64)> = result.size_classes.iter().map(|c| (c.lower, c.upper, c.asked)).collect();
+    assert_eq!(classes, [(2.8e-3, 4e-3, 0.5), (5.6e-3, 8e-3, 0.5)]);
+    // Recounted from the spheres' drawn diameters: each lies inside one class, mass ρπD³/6.
+    for class in &result.size_classes {
+        let masses: Vec<f64> = (packing.grains.iter())
+            .filter(|g| (class.lower..=class.upper).contains(&g.size))
+            .map(|g| density * std::f64::consts::PI * g.size.powi(3) / 6.0)
+            .collect();
+        let mass: f64 = masses.iter().sum();
+        assert!(!masses.is_empty());
+        assert_eq!(class.grains, masses.len());
+        assert!((class.mass - mass).abs() < 1e-12 * mass, "{} kg against {mass} kg", class.mass);
+    }
+    assert_eq!(result.size_classes.iter().map(|c| c.grains).sum::<usize>(), result.particles);
+    // Drawing stops at the grain that reaches m_tot: at most one grain over, an 8 mm sphere's 0.71 g.
+    let total: f64 = result.size_classes.iter().map(|c| c.mass).sum();
+    assert!((0.05..0.05 + 7.2e-4).contains(&total), "{total} kg created for 0.05 kg");
+}

@@ -337,6 +337,11 @@ impl Store {
             .as_ref()
             .map(|i| self.encode_json(i, &format!("imbrication of job {job_id}")))
             .transpose()?;
+        let size_classes = result
+            .size_classes
+            .as_ref()
+            .map(|c| self.encode_json(c, &format!("size classes of job {job_id}")))
+            .transpose()?;
         let now = now();
         let mut tx = self.pool.begin_with(sql::BEGIN_IMMEDIATE).await.map_err(self.db())?;
         let finished = sqlx::query(sql::FINISH_JOB)
@@ -364,6 +369,7 @@ impl Store {
             .bind(&result.solver_version)
             .bind(now)
             .bind(imbrication)
+            .bind(size_classes)
             .execute(&mut *tx)
             .await
             .map_err(self.db())?;
@@ -552,7 +558,7 @@ impl Store {
     /// from one snapshot.
     pub async fn export(&self, campaign: &str) -> Result<Vec<ExportRow>, StoreError> {
         type JobRow = (String, String, u64, u32, Option<String>, String, Option<f64>, Option<f64>, Option<String>);
-        type ResultRow = (String, f64, f64, f64, String, u64, f64, u64, f64, String, Option<String>);
+        type ResultRow = (String, f64, f64, f64, String, u64, f64, u64, f64, String, Option<String>, Option<String>);
         let mut tx = self.pool.begin().await.map_err(self.db())?;
         let campaign_id = self.campaign_id(&mut tx, campaign).await?;
         let jobs: Vec<JobRow> =
@@ -579,11 +585,14 @@ impl Store {
             wall_time,
             solver_version,
             imbrication,
+            size_classes,
         ) in results
         {
             let profile = self.decode_json(&profile, &format!("profile of job {job_id}"))?;
             let imbrication =
                 imbrication.map(|i| self.decode_json(&i, &format!("imbrication of job {job_id}"))).transpose()?;
+            let size_classes =
+                size_classes.map(|c| self.decode_json(&c, &format!("size classes of job {job_id}"))).transpose()?;
             let result = JobResult {
                 porosity,
                 z_minus,
@@ -595,6 +604,7 @@ impl Store {
                 wall_time,
                 solver_version,
                 imbrication,
+                size_classes,
             };
             results_by_job.insert(job_id, result);
         }

@@ -32,6 +32,7 @@ fn migrator() -> Migrator {
         migration(4, "fluid and imbrication", include_str!("../migrations/0004_fluid_and_imbrication.sql")),
         migration(5, "checkpoint stage", include_str!("../migrations/0005_checkpoint_stage.sql")),
         migration(6, "checkpoint shaking until", include_str!("../migrations/0006_checkpoint_shaking_until.sql")),
+        migration(7, "result size classes", include_str!("../migrations/0007_result_size_classes.sql")),
     ])
 }
 

@@ -87,8 +87,8 @@ pub const RUNNING_JOBS: &str = "
 // Results
 pub const INSERT_RESULT: &str = "
     INSERT INTO results (job_id, porosity, z_minus, z_plus, profile, particles, simulated_time,
-                         steps, wall_time, solver_version, created_at, imbrication)
-    VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12)";
+                         steps, wall_time, solver_version, created_at, imbrication, size_classes)
+    VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13)";
 pub const INSERT_GRAIN_STATISTIC: &str =
     "INSERT INTO grain_statistics (job_id, name, mean, std) VALUES (?1, ?2, ?3, ?4)";
 
@@ -132,7 +132,7 @@ pub const EXPORT_JOBS: &str = "
     WHERE campaign_id = ?1 ORDER BY rowid";
 pub const EXPORT_RESULTS: &str = "
     SELECT results.job_id, porosity, z_minus, z_plus, profile, particles, simulated_time, steps,
-           results.wall_time, solver_version, imbrication
+           results.wall_time, solver_version, imbrication, size_classes
     FROM results JOIN jobs ON jobs.id = results.job_id
     WHERE jobs.campaign_id = ?1";
 pub const EXPORT_GRAIN_STATISTICS: &str = "

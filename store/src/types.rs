@@ -102,6 +102,10 @@ pub struct JobResult {
     pub solver_version: String,
     /// The grains' imbrication as the caller wrote it, for packings that report one.
     pub imbrication: Option<Value>,
+    /// Grains and mass per sieve class as the caller wrote them; None for results stored
+    /// before sedpack recorded them.
+    #[serde(default)]
+    pub size_classes: Option<Value>,
 }
 
 /// Number-based mean and std of one form factor ("FL") or its inverse ("inv_FL") over a job's grains.

@@ -318,7 +318,11 @@ async fn export_gives_every_job_with_its_result_and_statistics() {
     store.add_jobs("other", &[job(50)]).await.unwrap();
     let first = store.claim(CAMPAIGN, "w1", None).await.unwrap().unwrap();
     let second = store.claim(CAMPAIGN, "w1", None).await.unwrap().unwrap();
-    let imbricated = JobResult { imbrication: Some(json!({"mean_dip": 21.5, "upstream": 0.6})), ..result(0.371) };
+    let imbricated = JobResult {
+        imbrication: Some(json!({"mean_dip": 21.5, "upstream": 0.6})),
+        size_classes: Some(json!([{"lower": 0.0056, "upper": 0.008, "asked": 1.0, "grains": 40, "mass": 0.02}])),
+        ..result(0.371)
+    };
     store.complete(&first.id, "w1", &imbricated, &statistics(0.647)).await.unwrap();
     store.fail(&second.id, "w1", "solver diverged").await.unwrap();
 

@@ -11,6 +11,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use serde_json::{Map, Value, json};
 use solver::fabric::Imbrication;
+use solver::grain::DrawnClass;
 use solver::packing::{Packing, PackingResult, Phase};
 
 use crate::cli::PackArgs;
@@ -42,6 +43,8 @@ struct ResultFile<'a> {
     /// With fluid forces on: the long axes' fabric against the flow.
     #[serde(skip_serializing_if = "Option::is_none")]
     imbrication: Option<&'a Imbrication>,
+    /// Grains and mass created per sieve class, against the curve's mass fractions.
+    size_classes: &'a [DrawnClass],
 }
 
 pub fn run(args: &PackArgs) -> anyhow::Result<()> {
@@ -104,6 +107,13 @@ pub fn run(args: &PackArgs) -> anyhow::Result<()> {
             ),
         );
     }
+    if record.size_classes.iter().filter(|c| c.asked > 0.0).count() > 1 {
+        let total: f64 = record.size_classes.iter().map(|c| c.mass).sum();
+        let shares: Vec<String> = (record.size_classes.iter())
+            .map(|c| format!("{} {:.1} % ({:.0} % asked)", c.label(), 100.0 * c.mass / total, 100.0 * c.asked))
+            .collect();
+        table.row("mass per class", shares.join(", "));
+    }
     table.row("output", out.display().to_string());
     table.print()?;
     Ok(())
@@ -164,6 +174,7 @@ fn result_file<'a>(job: &'a JobSpec, result: &'a PackingResult) -> ResultFile<'a
         statistics,
         profile: &result.porosity.profile,
         imbrication: result.imbrication.as_ref(),
+        size_classes: &result.size_classes,
     }
 }
 

@@ -317,6 +317,9 @@ mod tests {
                 wall_time: 0.5,
                 solver_version: "0.1.0".into(),
                 imbrication: Some(serde_json::json!({"grains": 40, "upstream": 0.6})),
+                size_classes: Some(
+                    serde_json::json!([{"lower": 0.0056, "upper": 0.008, "asked": 1.0, "grains": 60, "mass": 0.02}]),
+                ),
             },
             grain_statistics: vec![GrainStatistic { name: "FL".into(), mean: 1.0, std: 0.0 }],
         }

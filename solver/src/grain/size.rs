@@ -178,6 +178,28 @@ impl SieveCurve {
         (self.sieves[class] * self.sieves[class + 1]).sqrt()
     }
 
+    /// The packing's grains per class as drawn, from each created grain's (class, mass in kg):
+    /// every class the curve asks for or a grain fell in, in sieve order. §3.2 draws each grain's
+    /// class at random, so a seed's mass fractions scatter around the curve's, most for a wide
+    /// curve whose coarse classes hold few grains.
+    pub fn drawn(&self, grains: impl IntoIterator<Item = (usize, f64)>) -> Vec<DrawnClass> {
+        let mut classes: Vec<DrawnClass> = (0..self.classes())
+            .map(|i| DrawnClass {
+                lower: self.sieves[i],
+                upper: self.sieves[i + 1],
+                asked: self.fractions[i],
+                grains: 0,
+                mass: 0.0,
+            })
+            .collect();
+        for (class, mass) in grains {
+            classes[class].grains += 1;
+            classes[class].mass += mass;
+        }
+        classes.retain(|c| c.asked > 0.0 || c.grains > 0);
+        classes
+    }
+
     /// Number of grains per class n_i = m_i m_tot / (ρ_p V̄_i) with V̄_i = π d̄_i³/6, Eq. 9.
     pub fn grain_numbers(&self, total_mass: f64, density: f64) -> Vec<f64> {
         (0..self.classes())
@@ -203,6 +225,29 @@ impl SieveCurve {
             cumulative.push(sum);
         }
         SizeSampler { log_sieves: self.sieves.iter().map(|s| s.ln()).collect(), cumulative }
+    }
+}
+
+/// One sieve class of a finished packing: the grains created in it and their mass, beside the
+/// mass fraction the sieve curve asked for.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct DrawnClass {
+    /// Lower sieve (m).
+    pub lower: f64,
+    /// Upper sieve (m).
+    pub upper: f64,
+    /// The curve's mass fraction of the class.
+    pub asked: f64,
+    pub grains: usize,
+    /// Mass created in the class (kg).
+    pub mass: f64,
+}
+
+impl DrawnClass {
+    /// "5.6–8 mm", as the sieves are named.
+    pub fn label(&self) -> String {
+        let mm = |x: f64| format!("{:.2}", 1e3 * x).trim_end_matches('0').trim_end_matches('.').to_string();
+        format!("{}–{} mm", mm(self.lower), mm(self.upper))
     }
 }
 

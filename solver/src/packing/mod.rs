@@ -27,7 +27,7 @@ use crate::dem::{NewBody, Settings, Shape, Simulation, uniform_rotation};
 use crate::fabric::{Imbrication, imbrication};
 use crate::fluid::Fluid;
 use crate::grain::{
-    FormParameters, FormSampler, FormStatistic, MeshLibrary, SizeSampler, bonded_grain, form_statistics,
+    DrawnClass, FormParameters, FormSampler, FormStatistic, MeshLibrary, SizeSampler, bonded_grain, form_statistics,
 };
 use crate::porosity::{self, Porosity, PorosityError, PorositySettings};
 
@@ -122,6 +122,8 @@ pub struct PackingResult {
     /// The long axes' fabric against the flow (+x), for packings deposited with fluid forces on
     /// and grains that have a long axis.
     pub imbrication: Option<Imbrication>,
+    /// Grains and mass created per sieve class, against the curve's mass fractions.
+    pub size_classes: Vec<DrawnClass>,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -458,7 +460,15 @@ impl Packing {
             wall_time: self.wall_time,
             statistics: form_statistics(&self.grains.iter().map(|g| g.form).collect::<Vec<_>>()),
             imbrication: self.fluid.and_then(|_| imbrication(&b.shape, &b.orientation)),
+            size_classes: self.drawn_classes(),
         })
+    }
+
+    /// The grains created so far per sieve class; body k is grain k, as no body is ever removed.
+    fn drawn_classes(&self) -> Vec<DrawnClass> {
+        let density = self.spec.material.density;
+        let masses = self.simulation.bodies.volume.iter().map(|v| density * v);
+        self.spec.grains.size.drawn(self.grains.iter().map(|g| g.class).zip(masses))
     }
 }
 

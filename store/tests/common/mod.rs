@@ -50,6 +50,7 @@ pub fn result(porosity: f64) -> JobResult {
         wall_time: 42.0,
         solver_version: "sedpack 0.1.0".into(),
         imbrication: None,
+        size_classes: None,
     }
 }
 
