@@ -164,13 +164,14 @@ fn distribution_record(d: &DistributionArgs) -> anyhow::Result<Map<String, Value
 /// A column of `forms --library`: JSON key, table heading, value of a mesh.
 type Column = (&'static str, &'static str, fn(&Angularity) -> f64);
 
-const LIBRARY_COLUMNS: [Column; 6] = [
+const LIBRARY_COLUMNS: [Column; 7] = [
     ("FL", "FL", |a| a.form.s / a.form.i),
     ("EL", "EL", |a| a.form.i / a.form.l),
     ("sphericity", "sphericity", |a| a.sphericity),
     ("ellipsoid_sphericity", "ellipsoid", |a| a.ellipsoid_sphericity),
     ("relative_sphericity", "relative", Angularity::relative_sphericity),
     ("volume_ratio", "volume", |a| a.volume_ratio),
+    ("largest_facet", "facet", |a| a.largest_facet),
 ];
 
 /// One row per mesh of a library (own form, sphericities, angularity) and their means and
@@ -236,7 +237,7 @@ fn library(source: &str, faces: usize, json: bool) -> anyhow::Result<()> {
     line("standard deviation", "", &mut summary.iter().map(|(_, std)| format!("{std:>10.3}")))?;
     line("Table 2 (Rhine)", "", &mut [table2.mu_fl, table2.mu_el].iter().map(|m| format!("{m:>10.3}")))?;
     outln!(
-        "Table 2: the paper's 63 scans (standard deviations {:.3}, {:.3}). sphericity: Wadell's, of the mesh and of its mass-equivalent ellipsoid (Appendix A); relative: their ratio, 1 for an ellipsoid and lower the more angular the grain at its form; volume: the mesh's over that ellipsoid's",
+        "Table 2: the paper's 63 scans (standard deviations {:.3}, {:.3}). sphericity: Wadell's, of the mesh and of its mass-equivalent ellipsoid (Appendix A); relative: their ratio, 1 for an ellipsoid and lower the more angular the grain at its form; volume: the mesh's over that ellipsoid's; facet: the share of the surface on the largest flat facet with the form removed (stretched to L = I = S; triangles joined across edges, normals within 3°)",
         table2.sigma_fl,
         table2.sigma_el
     )?;

@@ -138,6 +138,16 @@ impl TriMesh {
         self.triangles[t].map(|v| self.vertices[v as usize])
     }
 
+    /// Surface area: the triangles' areas summed.
+    pub fn surface(&self) -> f64 {
+        (0..self.triangles.len())
+            .map(|t| {
+                let [a, b, c] = self.triangle(t);
+                0.5 * (b - a).cross(&(c - a)).norm()
+            })
+            .sum()
+    }
+
     fn bounding_box_diagonal(&self) -> f64 {
         let mut lo = Vector3::repeat(f64::INFINITY);
         let mut hi = Vector3::repeat(f64::NEG_INFINITY);
