@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 use solver::fabric::Imbrication;
-use solver::grain::DrawnClass;
+use solver::grain::{DrawnClass, graded, mass_shares};
 use thiserror::Error;
 
 use crate::campaign::{Analysis, PACKINGS_PER_FEATURE, Support};
@@ -388,8 +388,8 @@ fn setups_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
 /// every grain's class at random, so seeds of one setup hold different mixes, which the spread
 /// of their porosities may follow.
 fn size_classes_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
-    let graded = |r: &&JobRecord| r.size_classes.iter().filter(|c| c.asked > 0.0).count() > 1;
-    let shown: Vec<(&JobRecord, String)> = records.iter().zip(short_ids(records)).filter(|(r, _)| graded(r)).collect();
+    let shown: Vec<(&JobRecord, String)> =
+        records.iter().zip(short_ids(records)).filter(|(r, _)| graded(&r.size_classes)).collect();
     if shown.is_empty() {
         return;
     }
@@ -405,17 +405,17 @@ fn size_classes_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
     let rows = shown
         .iter()
         .map(|(r, id)| {
-            let total: f64 = r.size_classes.iter().map(|c| c.mass).sum();
+            let shares = mass_shares(&r.size_classes);
             let mut row = vec![format!("`{id}`")];
             row.extend(varied.iter().map(|(k, _)| r.parameters.get(k).map_or("–".into(), value_text)));
             row.extend([r.cost.grains.to_string(), format!("{:.4}", r.porosity)]);
             row.extend(sieves.iter().map(|s| {
-                r.size_classes
-                    .iter()
-                    .find(|c| (c.lower, c.upper) == (s.lower, s.upper))
-                    .map_or("–".into(), |c| format!("{:.1} ({})", 100.0 * c.mass / total, trimmed(100.0 * c.asked)))
+                (r.size_classes.iter().zip(&shares))
+                    .find(|(c, _)| (c.lower, c.upper) == (s.lower, s.upper))
+                    .map_or("–".into(), |(c, share)| format!("{:.1} ({})", 100.0 * share, trimmed(100.0 * c.asked)))
             }));
-            let off: f64 = r.size_classes.iter().map(|c| (c.mass / total - c.asked).abs()).sum::<f64>() / 2.0;
+            let off: f64 =
+                r.size_classes.iter().zip(&shares).map(|(c, share)| (share - c.asked).abs()).sum::<f64>() / 2.0;
             row.push(format!("{:.1}", 100.0 * off));
             row
         })

@@ -11,7 +11,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use serde_json::{Map, Value, json};
 use solver::fabric::Imbrication;
-use solver::grain::DrawnClass;
+use solver::grain::{DrawnClass, graded, mass_shares};
 use solver::packing::{Packing, PackingResult, Phase};
 
 use crate::cli::PackArgs;
@@ -107,10 +107,9 @@ pub fn run(args: &PackArgs) -> anyhow::Result<()> {
             ),
         );
     }
-    if record.size_classes.iter().filter(|c| c.asked > 0.0).count() > 1 {
-        let total: f64 = record.size_classes.iter().map(|c| c.mass).sum();
-        let shares: Vec<String> = (record.size_classes.iter())
-            .map(|c| format!("{} {:.1} % ({:.0} % asked)", c.label(), 100.0 * c.mass / total, 100.0 * c.asked))
+    if graded(record.size_classes) {
+        let shares: Vec<String> = (record.size_classes.iter().zip(mass_shares(record.size_classes)))
+            .map(|(c, share)| format!("{} {:.1} % ({:.0} % asked)", c.label(), 100.0 * share, 100.0 * c.asked))
             .collect();
         table.row("mass per class", shares.join(", "));
     }

@@ -48,10 +48,7 @@ impl Angularity {
             ellipsoid_sphericity: equal_volume_sphere_surface(ellipsoid_volume)
                 / ellipsoid_surface(&ellipsoid.semi_axes),
             volume_ratio: props.volume / ellipsoid_volume,
-            largest_facet: {
-                let unit = UnitMesh::new(mesh)?;
-                largest_facet(unit.mesh()) / unit.mesh().surface()
-            },
+            largest_facet: largest_facet(UnitMesh::new(mesh)?.mesh()),
         })
     }
 
@@ -65,7 +62,7 @@ impl Angularity {
 /// triangulated by a hull or a simplification, not the gently curved faces of a fine mesh.
 pub const FACET_ANGLE_DEGREES: f64 = 3.0;
 
-/// Area of the mesh's largest facet: triangles joined across edges whose normals all lie within
+/// Share of the mesh's surface on its largest facet: triangles joined across edges whose normals all lie within
 /// [`FACET_ANGLE_DEGREES`] of the facet's first (largest) triangle's, grown from the largest
 /// triangle not yet on a facet, so that a smooth surface cannot chain into one facet.
 pub fn largest_facet(mesh: &TriMesh) -> f64 {
@@ -111,5 +108,5 @@ pub fn largest_facet(mesh: &TriMesh) -> f64 {
         }
         largest = largest.max(area);
     }
-    largest
+    largest / areas.iter().sum::<f64>()
 }

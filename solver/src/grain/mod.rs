@@ -30,5 +30,7 @@ pub use form_distribution::{DistributionError, FormDistribution, FormMoments, Fo
 pub use library::{MeshLibrary, folder_meshes, rhine_meshes};
 pub use mesh::{MassProperties, MeshDefect, MeshError, TriMesh};
 pub use simplify::{Simplified, SimplifyError, simplify};
-pub use size::{DrawnClass, SieveCurve, SizeError, SizeSampler, TABLE3, TABLE3_SIEVES, Table3Case};
+pub use size::{
+    DrawnClass, SieveCurve, SizeError, SizeSampler, TABLE3, TABLE3_SIEVES, Table3Case, graded, mass_shares,
+};
 pub use unit_mesh::UnitMesh;

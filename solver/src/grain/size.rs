@@ -243,6 +243,18 @@ pub struct DrawnClass {
     pub mass: f64,
 }
 
+/// Whether the curve behind a packing's drawn classes asks for more than one: only then can its
+/// seeds draw different mixes.
+pub fn graded(classes: &[DrawnClass]) -> bool {
+    classes.iter().filter(|c| c.asked > 0.0).count() > 1
+}
+
+/// Each drawn class's share of the mass created, to set beside the curve's `asked`.
+pub fn mass_shares(classes: &[DrawnClass]) -> Vec<f64> {
+    let total: f64 = classes.iter().map(|c| c.mass).sum();
+    classes.iter().map(|c| c.mass / total).collect()
+}
+
 impl DrawnClass {
     /// "5.6–8 mm", as the sieves are named.
     pub fn label(&self) -> String {
