@@ -81,6 +81,10 @@ fn forms_library_gives_each_meshs_form_and_angularity_and_their_means() {
     assert!(close(&v["summary"]["sphericity"]["mean"], 0.5 * (wadell(6.0, 22.0) + wadell(1.0, 6.0))));
     // With the form removed a box is a cube: its largest facet is a sixth of its surface.
     assert!(close(&boxed["largest_facet"], 1.0 / 6.0) && close(&cube["largest_facet"], 1.0 / 6.0));
+    // A cube's inertia-equivalent sphere has radius a with a²/5 = 1/12 (per unit mass, side 1):
+    // its corners, √3/2 from the centre, lie 3/√5 radii out.
+    let corner = 3.0 / 5f64.sqrt();
+    assert!(close(&boxed["farthest_vertex"], corner) && close(&cube["farthest_vertex"], corner));
     assert!(close(&v["summary"]["FL"]["mean"], 0.75) && close(&v["summary"]["FL"]["std"], 0.5f64.sqrt() * 0.5));
     assert!(close(&v["table2"]["mu_FL"], 0.647));
     fails(&["forms", "--library", "no-such-folder"], &["--library no-such-folder", "folder of meshes"]);

@@ -210,6 +210,9 @@ fn angularity_of_a_cube_and_of_a_fine_ellipsoid() {
     let block: Vec<_> = corners.iter().map(|c| c.component_mul(&nalgebra::Vector3::new(1.0, 2.0, 3.0))).collect();
     let block = Angularity::of(&TriMesh::convex_hull(&block).unwrap()).unwrap();
     assert!((block.largest_facet - 1.0 / 6.0).abs() < 1e-12, "{block:?}");
+    // Its corners lie √3 s/2 from the centre, 3/√5 sphere radii; the box's alike with the form removed.
+    assert!((cube.farthest_vertex - 3.0 / 5f64.sqrt()).abs() < 1e-12, "{cube:?}");
+    assert!((block.farthest_vertex - 3.0 / 5f64.sqrt()).abs() < 1e-12, "{block:?}");
     // The hull of 4,000 points on an ellipsoid of axes 1 : 0.6 : 0.3: an inscribed polyhedron
     // whose surface and volume differ from the ellipsoid's by O(1/N) relative (N vertices), a
     // few parts in 10³ here; its relative sphericity is 1 to within that.
@@ -238,12 +241,15 @@ fn angularity_of_a_cube_and_of_a_fine_ellipsoid() {
     // ln N / N = 0.2 % of the sphere for N = 4,000. A facet chained across the smoothly curved
     // surface would hold many times more.
     assert!(fine.largest_facet < 0.005, "{fine:?}");
+    // Every vertex lies on the ellipsoid, whose inscribed hull's equivalent ellipsoid is smaller
+    // by the same few parts in 10³.
+    assert!((fine.farthest_vertex - 1.0).abs() < 5e-3, "{fine:?}");
     assert!((fine.form.i / fine.form.l - 0.6).abs() < 5e-3 && (fine.form.s / fine.form.i - 0.5).abs() < 5e-3);
 }
 
 #[test]
-fn generated_pebbles_are_as_angular_as_the_rhine_scans_in_their_facets_and_their_bulk() {
-    use solver::grain::{Angularity, UnitMesh, rhine_meshes, simplify};
+fn generated_pebbles_are_like_the_rhine_scans_in_sphericity_bulk_facets_and_tips() {
+    use solver::grain::{Angularity, rhine_meshes, simplify};
     // Both libraries as packings use them: at most 300 faces. Each mean must match the scans'
     // within half the difference of the two scans; the largest facet, where the two scans lie
     // only 0.005 apart, within 0.015 (twice the standard error of 20 pebbles, 0.026 / √20).
@@ -253,27 +259,17 @@ fn generated_pebbles_are_as_angular_as_the_rhine_scans_in_their_facets_and_their
     // fracture face (largest facet 0.136 against 0.080) and tips reaching 1.29 of the
     // ellipsoid's semi-axis against 1.24, at a relative sphericity of 0.935: each packed
     // looser than the scans at the same forms.
-    struct Measures {
-        angularity: Angularity,
-        /// Farthest vertex from the centre with the form removed, over the ellipsoid's semi-axis.
-        reach: f64,
-    }
-    let measure = |mesh: &solver::grain::TriMesh| {
-        let mesh = simplify(mesh, 300).unwrap().mesh;
-        let unit = UnitMesh::new(&mesh).unwrap();
-        let reach = unit.mesh().vertices().iter().map(|v| 2.0 * v.norm()).fold(0.0, f64::max);
-        Measures { angularity: Angularity::of(&mesh).unwrap(), reach }
-    };
-    let scans: Vec<Measures> = rhine_meshes().iter().map(|(_, m)| measure(m)).collect();
-    let pebbles: Vec<Measures> = pebble_library(20, 1, 300).unwrap().iter().map(measure).collect();
-    let mean = |v: &[Measures], f: fn(&Measures) -> f64| v.iter().map(f).sum::<f64>() / v.len() as f64;
-    let half_gap = |f: fn(&Measures) -> f64| 0.5 * (f(&scans[0]) - f(&scans[1])).abs();
-    let differs = |f: fn(&Measures) -> f64| (mean(&pebbles, f) - mean(&scans, f)).abs();
-    let sphericity: fn(&Measures) -> f64 = |m| m.angularity.relative_sphericity();
-    let volume: fn(&Measures) -> f64 = |m| m.angularity.volume_ratio;
-    let facet: fn(&Measures) -> f64 = |m| m.angularity.largest_facet;
-    let reach: fn(&Measures) -> f64 = |m| m.reach;
-    let show = |v: &[Measures]| -> Vec<[f64; 4]> {
+    let measure = |mesh: &solver::grain::TriMesh| Angularity::of(&simplify(mesh, 300).unwrap().mesh).unwrap();
+    let scans: Vec<Angularity> = rhine_meshes().iter().map(|(_, m)| measure(m)).collect();
+    let pebbles: Vec<Angularity> = pebble_library(20, 1, 300).unwrap().iter().map(measure).collect();
+    let mean = |v: &[Angularity], f: fn(&Angularity) -> f64| v.iter().map(f).sum::<f64>() / v.len() as f64;
+    let half_gap = |f: fn(&Angularity) -> f64| 0.5 * (f(&scans[0]) - f(&scans[1])).abs();
+    let differs = |f: fn(&Angularity) -> f64| (mean(&pebbles, f) - mean(&scans, f)).abs();
+    let sphericity: fn(&Angularity) -> f64 = Angularity::relative_sphericity;
+    let volume: fn(&Angularity) -> f64 = |a| a.volume_ratio;
+    let facet: fn(&Angularity) -> f64 = |a| a.largest_facet;
+    let reach: fn(&Angularity) -> f64 = |a| a.farthest_vertex;
+    let show = |v: &[Angularity]| -> Vec<[f64; 4]> {
         v.iter().map(|m| [sphericity(m), volume(m), facet(m), reach(m)]).collect()
     };
     let (p, s) = (show(&pebbles), show(&scans));

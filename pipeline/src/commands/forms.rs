@@ -164,7 +164,7 @@ fn distribution_record(d: &DistributionArgs) -> anyhow::Result<Map<String, Value
 /// A column of `forms --library`: JSON key, table heading, value of a mesh.
 type Column = (&'static str, &'static str, fn(&Angularity) -> f64);
 
-const LIBRARY_COLUMNS: [Column; 7] = [
+const LIBRARY_COLUMNS: [Column; 8] = [
     ("FL", "FL", |a| a.form.s / a.form.i),
     ("EL", "EL", |a| a.form.i / a.form.l),
     ("sphericity", "sphericity", |a| a.sphericity),
@@ -172,6 +172,7 @@ const LIBRARY_COLUMNS: [Column; 7] = [
     ("relative_sphericity", "relative", Angularity::relative_sphericity),
     ("volume_ratio", "volume", |a| a.volume_ratio),
     ("largest_facet", "facet", |a| a.largest_facet),
+    ("farthest_vertex", "farthest", |a| a.farthest_vertex),
 ];
 
 /// One row per mesh of a library (own form, sphericities, angularity) and their means and
@@ -237,7 +238,7 @@ fn library(source: &str, faces: usize, json: bool) -> anyhow::Result<()> {
     line("standard deviation", "", &mut summary.iter().map(|(_, std)| format!("{std:>10.3}")))?;
     line("Table 2 (Rhine)", "", &mut [table2.mu_fl, table2.mu_el].iter().map(|m| format!("{m:>10.3}")))?;
     outln!(
-        "Table 2: the paper's 63 scans (standard deviations {:.3}, {:.3}). sphericity: Wadell's, of the mesh and of its mass-equivalent ellipsoid (Appendix A); relative: their ratio, 1 for an ellipsoid and lower the more angular the grain at its form; volume: the mesh's over that ellipsoid's; facet: the share of the surface on the largest flat facet with the form removed (stretched to L = I = S; triangles joined across edges, normals within 3°)",
+        "Table 2: the paper's 63 scans (standard deviations {:.3}, {:.3}). sphericity: Wadell's, of the mesh and of its mass-equivalent ellipsoid (Appendix A); relative: their ratio, 1 for an ellipsoid and lower the more angular the grain at its form; volume: the mesh's over that ellipsoid's; facet: the share of the surface on the largest flat facet with the form removed (stretched to L = I = S; triangles joined across edges, normals within 3°); farthest: the farthest vertex from the centre with the form removed, in semi-axes of that ellipsoid (3/√5 = 1.342 for a box)",
         table2.sigma_fl,
         table2.sigma_el
     )?;

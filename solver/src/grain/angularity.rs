@@ -33,6 +33,11 @@ pub struct Angularity {
     /// near 0 for a fine mesh of a smooth grain. A stretch flattens a curved side, so only a
     /// true plane, a fracture face or a cut, is a large facet at every form.
     pub largest_facet: f64,
+    /// Distance of the farthest vertex from the centre with the form removed, in semi-axes of
+    /// the mass-equivalent ellipsoid: near 1 for a fine mesh of an ellipsoid, 3/√5 = 1.342 for
+    /// any box. Tips and corners that reach beyond the ellipsoid raise it, and a stretch along
+    /// the principal axes leaves it unchanged.
+    pub farthest_vertex: f64,
 }
 
 impl Angularity {
@@ -42,13 +47,17 @@ impl Angularity {
         let form = ellipsoid.form()?;
         let surface = mesh.surface();
         let ellipsoid_volume = form.ellipsoid_volume();
+        let unit = UnitMesh::new(mesh)?;
+        // The unit mesh's ellipsoid has semi-axes 1/2.
+        let farthest_vertex = unit.mesh().vertices().iter().map(|v| 2.0 * v.norm()).fold(0.0, f64::max);
         Ok(Self {
             form,
             sphericity: equal_volume_sphere_surface(props.volume) / surface,
             ellipsoid_sphericity: equal_volume_sphere_surface(ellipsoid_volume)
                 / ellipsoid_surface(&ellipsoid.semi_axes),
             volume_ratio: props.volume / ellipsoid_volume,
-            largest_facet: largest_facet(UnitMesh::new(mesh)?.mesh()),
+            largest_facet: largest_facet(unit.mesh()),
+            farthest_vertex,
         })
     }
 

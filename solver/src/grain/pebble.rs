@@ -18,9 +18,9 @@ use super::simplify::{SimplifyError, simplify};
 /// ≤ 300 faces and the next coarser column).
 ///
 /// The shape is matched to the two scans in what a packing sees once a grain is rescaled to a
-/// drawn form (with the form removed): the relative sphericity at forms drawn from Table 2, the
-/// volume over that of the mass-equivalent ellipsoid (`Angularity`), the share of the surface
-/// on the largest flat facet, and how far the farthest vertex reaches beyond that ellipsoid. The
+/// drawn form (`Angularity`): the relative sphericity, also at forms drawn from Table 2, and,
+/// unchanged by any rescaling, the volume over that of the mass-equivalent ellipsoid, the share
+/// of the surface on the largest flat facet and how far the farthest vertex reaches. The
 /// knobs below are where a random search over them came closest to the scans in all four at
 /// once (docs/validation.md, "The scan library"). Pebbles that were an ellipsoid chipped by
 /// 8–13 shallow planes had the scans' sphericity but 0.967 of the ellipsoid's volume (the
