@@ -27,7 +27,7 @@ use crate::stored;
 /// A running job proves it is alive this often.
 const HEARTBEAT: Duration = Duration::from_secs(10);
 /// A job whose heartbeat is older than this belongs to a dead runner.
-const STALE_AFTER: Duration = Duration::from_secs(60);
+pub const STALE_AFTER: Duration = Duration::from_secs(60);
 /// Time steps between progress reports and stop checks (0.01 s simulated at the default Δt), few
 /// enough that a large packing stops within seconds when Slurm's time limit nears.
 const STEPS_PER_REPORT: u64 = 2_000;

@@ -346,6 +346,9 @@ fn a_killed_runner_resumes_from_its_checkpoint_with_identical_results() {
     );
     let simulated = in_progress[0]["checkpoint"][0].as_f64().expect("a checkpoint");
     assert!(simulated > 0.0, "{in_progress}");
+    let started = in_progress[0]["started_at"].as_f64().expect("a start");
+    let heard = in_progress[0]["heartbeat_at"].as_f64().expect("a heartbeat");
+    assert!(heard >= started, "{in_progress}");
     let text = ok(&["status", "killed", "--db", db]);
     assert!(text.contains(&format!("checkpoint at {simulated:.2} s simulated")), "{text}");
     // The time left: for each job left, the mean wall time of the done jobs of its setup (its

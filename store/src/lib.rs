@@ -506,6 +506,7 @@ impl Store {
             Option<f64>,
             Option<f64>,
             Option<f64>,
+            Option<f64>,
             Option<String>,
             Option<i64>,
             Option<f64>,
@@ -517,8 +518,20 @@ impl Store {
         let in_progress = in_progress
             .into_iter()
             .map(|row| {
-                let (job_id, state, worker_id, attempts, started_at, simulated, written, phase, grains, mass, until) =
-                    row;
+                let (
+                    job_id,
+                    state,
+                    worker_id,
+                    attempts,
+                    started_at,
+                    heartbeat_at,
+                    simulated,
+                    written,
+                    phase,
+                    grains,
+                    mass,
+                    until,
+                ) = row;
                 let stage = match (phase, grains, mass) {
                     (Some(phase), Some(grains), Some(mass_created)) => {
                         Some(Stage { phase, grains: grains as u64, mass_created, shaking_until: until })
@@ -531,6 +544,7 @@ impl Store {
                     worker_id,
                     attempts,
                     started_at,
+                    heartbeat_at,
                     checkpoint: simulated.zip(written),
                     stage,
                 })

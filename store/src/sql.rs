@@ -117,7 +117,7 @@ pub const STATUS_COUNTS: &str = "
            AVG(results.simulated_time) FILTER (WHERE jobs.state = 'done')
     FROM jobs LEFT JOIN results ON results.job_id = jobs.id WHERE jobs.campaign_id = ?1";
 pub const IN_PROGRESS: &str = "
-    SELECT jobs.id, jobs.state, jobs.worker_id, jobs.attempts, jobs.started_at,
+    SELECT jobs.id, jobs.state, jobs.worker_id, jobs.attempts, jobs.started_at, jobs.heartbeat_at,
            checkpoints.simulated_time, checkpoints.written_at,
            checkpoints.phase, checkpoints.grains, checkpoints.mass_created, checkpoints.shaking_until
     FROM jobs LEFT JOIN checkpoints ON checkpoints.job_id = jobs.id

@@ -185,6 +185,8 @@ pub struct Progress {
     pub attempts: u32,
     /// Unix time the current attempt started (None when pending).
     pub started_at: Option<f64>,
+    /// Unix time of the running attempt's last heartbeat (None when pending).
+    pub heartbeat_at: Option<f64>,
     /// Simulated time (s) and unix time of its last checkpoint in the database, if any.
     pub checkpoint: Option<(f64, f64)>,
     /// Where the packing stood at that checkpoint (None for checkpoints of sedpack before 0.2.1).

@@ -606,13 +606,17 @@ pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
         }
         for r in &records {
             let s = &r.status;
+            let now = unix_now();
+            // Slurm tasks report through the run directory, not heartbeats: only local jobs fall silent.
+            let silent = if r.tasks.is_none() { s.in_progress.iter().filter(|p| is_silent(p, now)).count() } else { 0 };
+            let silent = if silent > 0 { format!(" ({silent} without a heartbeat)") } else { String::new() };
             let mut table = Table::default();
             table
                 .row("campaign", s.campaign.clone())
                 .row(
                     "jobs",
                     format!(
-                        "{} ({} done, {} failed, {} running, {} pending)",
+                        "{} ({} done, {} failed, {} running{silent}, {} pending)",
                         s.jobs, s.done, s.failed, s.running, s.pending
                     ),
                 )
@@ -627,7 +631,6 @@ pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
                 table.row(format!("failed {}", f.job_id), f.error.clone());
             }
             if r.tasks.is_none() {
-                let now = unix_now();
                 for p in &s.in_progress {
                     table.row(format!("job {}", p.job_id), progress_text(p, now));
                 }
@@ -657,9 +660,16 @@ fn unix_now() -> f64 {
     std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0.0, |d| d.as_secs_f64())
 }
 
+/// Whether a running local job's runner has not sent a heartbeat for longer than `resume` waits
+/// before it takes the job over: the process was killed, or its machine went down.
+fn is_silent(p: &Progress, now: f64) -> bool {
+    p.state == JobState::Running && p.heartbeat_at.is_some_and(|t| now - t > runner::STALE_AFTER.as_secs_f64())
+}
+
 /// A local job in progress in words: "running for 32 min 10 s on vm:1:0 (attempt 2); checkpoint
 /// at 1.90 s simulated (generation, 1972 grains, 38 % of the mass), 2 min 05 s ago"; while the
-/// packing shakes, its phase says when the shaking ends ("shaking until 6.25 s").
+/// packing shakes, its phase says when the shaking ends ("shaking until 6.25 s"). A job whose
+/// runner fell silent says so, and what `resume` will do with it.
 fn progress_text(p: &Progress, now: f64) -> String {
     let ago = |t: f64| duration((now - t).max(0.0));
     // The share of the mass created says how far the generation is, which simulated time does not.
@@ -676,8 +686,16 @@ fn progress_text(p: &Progress, now: f64) -> String {
         Some((simulated, written)) => format!("checkpoint at {simulated:.2} s simulated{stage}, {} ago", ago(written)),
         None => "no checkpoint yet".into(),
     };
-    match (&p.worker_id, p.started_at) {
-        (Some(worker), Some(started)) => {
+    match (&p.worker_id, p.started_at, p.heartbeat_at) {
+        (Some(worker), _, Some(heard)) if is_silent(p, now) => {
+            let next = if p.checkpoint.is_some() { "`resume` continues from it" } else { "`resume` starts it over" };
+            format!(
+                "stopped: no heartbeat from {worker} for {} (attempt {}); {checkpoint}: {next}",
+                ago(heard),
+                p.attempts
+            )
+        }
+        (Some(worker), Some(started), _) => {
             format!("running for {} on {worker} (attempt {}); {checkpoint}", ago(started), p.attempts)
         }
         _ => format!("pending; {checkpoint}: `resume` continues from it"),
@@ -784,6 +802,7 @@ mod tests {
             worker_id: Some("vm:1:0".into()),
             attempts: 2,
             started_at: Some(1000.0),
+            heartbeat_at: Some(2925.0),
             checkpoint: Some((1.9, 2800.0)),
             stage: Some(Stage { phase: "generation".into(), grains: 1972, mass_created: 0.382, shaking_until: None }),
         };
@@ -803,9 +822,29 @@ mod tests {
         );
         let old = Progress { stage: None, ..running.clone() };
         assert!(progress_text(&old, 2930.0).ends_with("checkpoint at 1.90 s simulated, 2 min 10 s ago"));
-        let fresh = Progress { checkpoint: None, stage: None, ..running.clone() };
+        let fresh = Progress { checkpoint: None, stage: None, heartbeat_at: Some(1025.0), ..running.clone() };
         assert!(progress_text(&fresh, 1030.0).ends_with("(attempt 2); no checkpoint yet"));
-        let stopped = Progress { state: JobState::Pending, worker_id: None, started_at: None, stage: None, ..running };
+        // `resume` takes a job over once its heartbeat is older than 60 s; so does this text.
+        assert!(progress_text(&running, 2985.0).starts_with("running for"));
+        assert!(!is_silent(&running, 2985.0));
+        assert!(is_silent(&running, 2986.0));
+        assert_eq!(
+            progress_text(&running, 2986.0),
+            "stopped: no heartbeat from vm:1:0 for 1 min 01 s (attempt 2); checkpoint at 1.90 s simulated \
+             (generation, 1972 grains, 38 % of the mass), 3 min 06 s ago: `resume` continues from it"
+        );
+        assert_eq!(
+            progress_text(&fresh, 1100.0),
+            "stopped: no heartbeat from vm:1:0 for 1 min 15 s (attempt 2); no checkpoint yet: `resume` starts it over"
+        );
+        let stopped = Progress {
+            state: JobState::Pending,
+            worker_id: None,
+            started_at: None,
+            heartbeat_at: None,
+            stage: None,
+            ..running
+        };
         assert_eq!(
             progress_text(&stopped, 2810.0),
             "pending; checkpoint at 1.90 s simulated, 10.0 s ago: `resume` continues from it"

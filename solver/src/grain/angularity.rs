@@ -44,10 +44,10 @@ impl Angularity {
     pub fn of(mesh: &TriMesh) -> Result<Self, FormError> {
         let props = mesh.mass_properties();
         let ellipsoid = EquivalentEllipsoid::of(&props);
-        let form = ellipsoid.form()?;
+        let unit = UnitMesh::with_ellipsoid(mesh, &ellipsoid)?;
+        let form = unit.original_form();
         let surface = mesh.surface();
         let ellipsoid_volume = form.ellipsoid_volume();
-        let unit = UnitMesh::new(mesh)?;
         // The unit mesh's ellipsoid has semi-axes 1/2.
         let farthest_vertex = unit.mesh().vertices().iter().map(|v| 2.0 * v.norm()).fold(0.0, f64::max);
         Ok(Self {

@@ -20,7 +20,11 @@ impl UnitMesh {
     /// Fig. 5a → 5b. Scaling along principal axes keeps them principal and scales each semi-axis
     /// of the equivalent ellipsoid by exactly its factor, so one pass suffices.
     pub fn new(mesh: &TriMesh) -> Result<Self, FormError> {
-        let ellipsoid = EquivalentEllipsoid::of(&mesh.mass_properties());
+        Self::with_ellipsoid(mesh, &EquivalentEllipsoid::of(&mesh.mass_properties()))
+    }
+
+    /// As [`UnitMesh::new`], for a caller that already holds the mesh's equivalent ellipsoid.
+    pub fn with_ellipsoid(mesh: &TriMesh, ellipsoid: &EquivalentEllipsoid) -> Result<Self, FormError> {
         let original = ellipsoid.form()?;
         let inverse_axes = Vector3::new(1.0 / original.l, 1.0 / original.i, 1.0 / original.s);
         let rotation_inverse = ellipsoid.rotation.inverse();
