@@ -34,7 +34,7 @@ const STEPS_PER_REPORT: u64 = 2_000;
 /// A checkpoint is this number followed by the packing; a checkpoint with another number was
 /// written by another version of sedpack and is not used. Raise it whenever `Packing`'s
 /// serialised form changes.
-pub const CHECKPOINT_FORMAT: u32 = 12;
+pub const CHECKPOINT_FORMAT: u32 = 13;
 
 #[derive(Debug, Clone)]
 pub struct RunOptions {

@@ -18,12 +18,12 @@ use parry3d_f64::shape::SupportMap;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use solver::dem::contact::centre_of_pressure::Overlap;
-use solver::dem::contact::coherence::Features;
+use solver::dem::contact::coherence::{Features, Kept};
 use solver::dem::contact::ellipsoid::EllipsoidPose;
 use solver::dem::contact::polyhedron::{
-    Mode, PolyhedronPose, polyhedron_cylinder_wall, polyhedron_cylinder_wall_witness, polyhedron_ellipsoid,
-    polyhedron_plane, polyhedron_plane_witness, polyhedron_polyhedron, polyhedron_polyhedron_coherent,
-    polyhedron_polyhedron_with_stats, polyhedron_sphere,
+    Apart, Mode, PolyhedronPose, PolyhedronStats, polyhedron_cylinder_wall, polyhedron_cylinder_wall_witness,
+    polyhedron_ellipsoid, polyhedron_plane, polyhedron_plane_witness, polyhedron_polyhedron,
+    polyhedron_polyhedron_coherent, polyhedron_polyhedron_with_stats, polyhedron_sphere,
 };
 use solver::dem::contact::{ContactGeometry, ContactPoint};
 use solver::dem::shape::ConvexPolyhedron;
@@ -872,6 +872,17 @@ fn parry_distance(a: &PolyhedronPose, b: &PolyhedronPose) -> f64 {
         .distance
 }
 
+/// The engine's query of a pair (with its shortcuts), the force at the centre of pressure.
+fn coherent(
+    a: &PolyhedronPose,
+    b: &PolyhedronPose,
+    warm: Option<&V3>,
+    last_gap: f64,
+    features: &mut Features,
+) -> (Option<ContactGeometry>, Apart, PolyhedronStats) {
+    polyhedron_polyhedron_coherent(a, b, warm, last_gap, features, Mode::Coherent, ContactPoint::CentreOfPressure)
+}
+
 #[test]
 fn a_pair_still_apart_along_its_last_separating_direction_costs_one_query() {
     // Pebble hulls found apart, then moved as in a step of the engine. Shifting B by s changes
@@ -895,15 +906,7 @@ fn a_pair_still_apart_along_its_last_separating_direction_costs_one_query() {
         }
         tested += 1;
         let mut features = Features::default();
-        let (contact, first, _) = polyhedron_polyhedron_coherent(
-            &a,
-            &b,
-            None,
-            0.0,
-            &mut features,
-            Mode::Coherent,
-            ContactPoint::CentreOfPressure,
-        );
+        let (contact, first, _) = coherent(&a, &b, None, 0.0, &mut features);
         assert!(contact.is_none());
         let d = parry_distance(&a, &b);
         let g = first.gap;
@@ -912,15 +915,7 @@ fn a_pair_still_apart_along_its_last_separating_direction_costs_one_query() {
         let shift = random_unit(&mut rng) * (rng.random_range(0.0..0.3) * g);
         let turn = rotation(random_unit(&mut rng), 0.1 * g / sb.bounding_radius()) * rb;
         let moved = PolyhedronPose::new(sb, b.center() + shift, &turn);
-        let (contact, apart, stats) = polyhedron_polyhedron_coherent(
-            &a,
-            &moved,
-            Some(&first.direction),
-            g,
-            &mut features,
-            Mode::Coherent,
-            ContactPoint::CentreOfPressure,
-        );
+        let (contact, apart, stats) = coherent(&a, &moved, Some(&first.direction), g, &mut features);
         assert!(contact.is_none());
         assert_eq!(stats.support_queries, 1);
         // The same direction, normalised again.
@@ -929,21 +924,83 @@ fn a_pair_still_apart_along_its_last_separating_direction_costs_one_query() {
         assert!(apart.gap >= 0.6 * g - 1e-12 && apart.gap <= d + 1e-9, "bound {} of {g}, distance {d}", apart.gap);
 
         let closer = PolyhedronPose::new(sb, b.center() - first.direction * (0.8 * g), &rb);
-        let (contact, apart, stats) = polyhedron_polyhedron_coherent(
-            &a,
-            &closer,
-            Some(&first.direction),
-            g,
-            &mut features,
-            Mode::Coherent,
-            ContactPoint::CentreOfPressure,
-        );
+        let (contact, apart, stats) = coherent(&a, &closer, Some(&first.direction), g, &mut features);
         assert!(contact.is_none());
         assert!(stats.support_queries > 1, "{stats:?}");
         let d = parry_distance(&a, &closer);
         assert!(apart.gap <= d + 1e-9 && apart.gap >= 0.95 * d - 1e-9, "bound {} for distance {d}", apart.gap);
     }
     assert!(tested > 100, "{tested} pairs");
+}
+
+#[test]
+fn a_pair_found_apart_starts_its_next_query_from_the_feature_it_ended_on() {
+    // A pair found apart keeps the vertex pairs of the feature of K its distance query ended on;
+    // the next query climbs from them instead of from the start table, and GJK starts from their
+    // points at the new poses. A climb ends on a farthest vertex wherever it starts, but which
+    // one of a tie depends on the start, and ties are the rule here: a separating direction GJK
+    // found is perpendicular to the feature of K nearest the origin, so that feature's vertices
+    // tie along it. The support value itself does not depend on the tie: a pair still apart
+    // along its old direction (one query) gets the cold query's bound (to 1e-13 of the grains'
+    // size ~1). A bound GJK finds again from the kept feature may differ from the cold query's
+    // but must be as good: within [0.95 d, d] of parry's distance d (1e-9 for parry's rounding).
+    // EPA ends on the same face of K either way: a contact must be the cold query's (depth to
+    // 1e-13, normal and point to 1e-9, as a warm start's above). Queries: still apart along the
+    // old direction, apart but closer (GJK again, which must need fewer support queries in all
+    // than from the cold start), and moved into contact (EPA).
+    let mut rng = ChaCha8Rng::seed_from_u64(13);
+    let (mut tested, mut touching, mut warm_queries, mut cold_queries) = (0, 0, 0, 0);
+    for _ in 0..400 {
+        let pair = RandomPair::new(&mut rng);
+        let (sb, rb) = (&pair.sb, pair.turn_b);
+        let a = pair.a();
+        let b = pair.b_at(rng.random_range(1.02..1.2));
+        // Pairs whose bounding spheres are apart are answered without a support query.
+        if (b.center() - a.center()).norm() >= pair.sa.bounding_radius() + sb.bounding_radius() {
+            continue;
+        }
+        let mut features = Features::default();
+        let (contact, first, _) = coherent(&a, &b, None, 0.0, &mut features);
+        assert!(contact.is_none() && first.gap > 0.0);
+        assert!(matches!(features.kept, Kept::Apart { .. }), "{features:?}");
+        tested += 1;
+        let g = first.gap;
+        let turn = rotation(random_unit(&mut rng), 0.1 * g / sb.bounding_radius()) * rb;
+        for approach in [0.1, 0.8, 1.5] {
+            let moved = PolyhedronPose::new(sb, b.center() - first.direction * (approach * g), &turn);
+            let query = |features: &mut Features| coherent(&a, &moved, Some(&first.direction), g, features);
+            let (mut warm_features, mut cold_features) = (features, Features::default());
+            let (warm, warm_apart, warm_stats) = query(&mut warm_features);
+            let (cold, cold_apart, cold_stats) = query(&mut cold_features);
+            match (warm, cold) {
+                (Some(w), Some(c)) => {
+                    assert!((w.depth - c.depth).abs() < 1e-13, "approach {approach}: {w:?} {c:?}");
+                    assert!((w.normal - c.normal).norm() < 1e-9 && (w.point - c.point).norm() < 1e-9, "{w:?} {c:?}");
+                    touching += 1;
+                }
+                (None, None) if cold_stats.support_queries == 1 => {
+                    assert_eq!(warm_stats.support_queries, 1, "approach {approach}");
+                    assert!((warm_apart.gap - cold_apart.gap).abs() < 1e-13, "{warm_apart:?} {cold_apart:?}");
+                    assert_eq!(warm_apart.direction, cold_apart.direction);
+                }
+                (None, None) => {
+                    let d = parry_distance(&a, &moved);
+                    for apart in [warm_apart, cold_apart] {
+                        assert!(apart.gap <= d + 1e-9 && apart.gap >= 0.95 * d - 1e-9, "{apart:?}: distance {d}");
+                    }
+                    warm_queries += warm_stats.support_queries;
+                    cold_queries += cold_stats.support_queries;
+                }
+                other => panic!("approach {approach}: {other:?}"),
+            }
+            assert!(matches!(warm_features.kept, Kept::Apart { .. } | Kept::Contact { .. }), "{warm_features:?}");
+        }
+    }
+    eprintln!(
+        "support queries of the distances found again: from the kept feature {warm_queries}, cold {cold_queries}"
+    );
+    assert!(tested > 100 && touching > 20, "{tested} pairs, {touching} moved into contact");
+    assert!(warm_queries < cold_queries);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1170,32 +1227,14 @@ fn the_engines_shortcuts_on_persisting_contacts_match_independent_references() {
         let depth = if k % 2 == 0 { 1e-3 } else { 1e-2 } * size;
         let b = PolyhedronPose::new(&sb, m * (outside - depth), &rb);
         let mut features = Features::default();
-        let Some(first) = polyhedron_polyhedron_coherent(
-            &a,
-            &b,
-            None,
-            0.0,
-            &mut features,
-            Mode::Coherent,
-            ContactPoint::CentreOfPressure,
-        )
-        .0
-        else {
+        let Some(first) = coherent(&a, &b, None, 0.0, &mut features).0 else {
             continue;
         };
         let turn = |r: &Matrix3<f64>, rng: &mut ChaCha8Rng| rotation(random_unit(rng), 1e-4) * r;
         let (ra2, rb2) = (turn(&ra, &mut rng), turn(&rb, &mut rng));
         let a2 = PolyhedronPose::new(&sa, V3::zeros(), &ra2);
         let b2 = PolyhedronPose::new(&sb, b.center() + random_unit(&mut rng) * 1e-5 * size, &rb2);
-        let (c, _, stats) = polyhedron_polyhedron_coherent(
-            &a2,
-            &b2,
-            Some(&first.normal),
-            0.0,
-            &mut features,
-            Mode::Coherent,
-            ContactPoint::CentreOfPressure,
-        );
+        let (c, _, stats) = coherent(&a2, &b2, Some(&first.normal), 0.0, &mut features);
         let Some(c) = c else { continue };
         let (wa, wb) = (World::of(&a2), World::of(&b2));
         let (sat_depth, sat_normal, second) = sat(&wa, &wb);

@@ -11,7 +11,10 @@
 //!   shaken together keep their bound however fast they go. Once it is used up, the pair of
 //!   polyhedra is first tried along its last separating direction n: −h_K(n) is a new bound for
 //!   one support query, kept if it is at least half the last one (most near contacts of a bed,
-//!   requeried every few steps, end there); otherwise GJK finds the distance again.
+//!   requeried every few steps, end there); otherwise GJK finds the distance again, starting
+//!   from the points of K its last distance query ended on (the vertex pairs of the feature of K
+//!   nearest the origin, taken at the new poses), which a step mostly leaves the nearest. Either
+//!   query climbs each body from a vertex of that feature rather than from the start table.
 //! * Touching polyhedra: the vertices of EPA's last face of K = A − B and of a point of K on the
 //!   far side. Next step the same vertex pairs, at the new poses, make a tetrahedron of K; if it
 //!   still holds the origin EPA starts from it and, when the contact's features have not
@@ -62,14 +65,26 @@ impl PairCache {
     }
 }
 
-/// The features of a polyhedron pair's last contact: vertices of A and of B at the three
-/// corners of EPA's last face and at a far point of K, in the canonical order of the pair at
-/// that time.
+/// What a polyhedron pair keeps of its last query, in the canonical order of the pair at that
+/// time.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Features {
-    pub a: [u16; 4],
-    pub b: [u16; 4],
+    pub kept: Kept,
     pub order: Order,
+}
+
+/// The vertices a pair of polyhedra keeps.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub enum Kept {
+    #[default]
+    None,
+    /// Touching: the vertices of A and of B at the three corners of EPA's last face and at a far
+    /// point of K.
+    Contact { a: [u16; 4], b: [u16; 4] },
+    /// Apart: the vertices of A and of B of the points of K (`len`, 1 to 3) that the last
+    /// distance query ended on, the feature of K nearest the origin. The next distance query
+    /// starts GJK from them at the new poses, and its climbs from the first.
+    Apart { a: [u16; 3], b: [u16; 3], len: u8 },
 }
 
 /// Which body was A when the features were recorded.

@@ -239,19 +239,46 @@ pub(super) fn distance<A: Convex, B: Convex>(cso: &mut Cso<A, B>, start: &V3, bo
 /// support planes separates the bodies); the best such bound seen is returned once it is
 /// within [`SEPARATION_TOLERANCE`] of the simplex's distance, an upper bound. The direction n
 /// points from A towards B.
-pub(super) fn separation<A: Convex, B: Convex>(cso: &mut Cso<A, B>, u: &V3, tiny: f64) -> (f64, V3) {
-    let Some(u) = unit(u) else { return (0.0, V3::zeros()) };
+pub(super) fn separation<A: Convex, B: Convex>(cso: &mut Cso<A, B>, u: &V3, tiny: f64) -> Separation {
+    let Some(u) = unit(u) else { return Separation { gap: 0.0, direction: V3::zeros(), simplex: Simplex::default() } };
     let first = cso.support(&u);
-    separation_from(cso, &u, first, tiny)
+    separation_from(cso, &u, first, &[], tiny)
 }
 
-/// [`separation`] from the unit direction `u` whose support point `first` is already known.
-pub(super) fn separation_from<A: Convex, B: Convex>(cso: &mut Cso<A, B>, u: &V3, first: Point, tiny: f64) -> (f64, V3) {
+/// A lower bound on the distance of two bodies, its direction, and the simplex GJK ended on
+/// (the feature of K nearest the origin).
+pub(super) struct Separation {
+    pub gap: f64,
+    pub direction: V3,
+    pub simplex: Simplex,
+}
+
+/// [`separation`] from the unit direction `u` whose support point `first` is already known,
+/// and from `warm`, points of K near the origin (the last query's simplex at the new poses):
+/// any points of K bound the distance from above, so GJK may start from them. Out of line, so
+/// that its simplices do not weigh on the callers' common paths.
+#[inline(never)]
+pub(super) fn separation_from<A: Convex, B: Convex>(
+    cso: &mut Cso<A, B>,
+    u: &V3,
+    first: Point,
+    warm: &[Point],
+    tiny: f64,
+) -> Separation {
     let mut best = (-u.dot(&first.w), *u);
     let mut simplex = Simplex::default();
     simplex.push(first);
-    let mut v = first.w;
+    for p in warm {
+        if !simplex.p[..simplex.len].iter().any(|q| (q.vertex_a, q.vertex_b) == (p.vertex_a, p.vertex_b)) {
+            simplex.push(*p);
+        }
+    }
+    let mut v = simplex.reduce();
     for _ in 0..GJK_ITERATIONS {
+        // Four points hold the origin: impossible for bodies apart along `u`, but for rounding.
+        if simplex.len == 4 {
+            break;
+        }
         let vv = v.norm_squared();
         if vv <= tiny * tiny {
             break;
@@ -267,9 +294,6 @@ pub(super) fn separation_from<A: Convex, B: Convex>(cso: &mut Cso<A, B>, u: &V3,
         }
         simplex.push(w);
         v = simplex.reduce();
-        if simplex.len == 4 {
-            break;
-        }
     }
-    (best.0.max(0.0), best.1)
+    Separation { gap: best.0.max(0.0), direction: best.1, simplex }
 }

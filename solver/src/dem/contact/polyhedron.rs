@@ -36,10 +36,10 @@
 use nalgebra::{Matrix3, Vector2, Vector3};
 
 use super::centre_of_pressure::{self, Overlap};
-use super::coherence::{Features, Order};
+use super::coherence::{Features, Kept, Order};
 use super::ellipsoid::{EllipsoidPose, tangent_basis, unit};
 use super::epa::{self, Penetration};
-use super::gjk::{self, Distance};
+use super::gjk::{self, Distance, Simplex};
 use super::manifold::{self, Manifold};
 pub use super::support::PolyhedronPose;
 use super::support::{Centre, Convex, Cso, Point};
@@ -139,9 +139,12 @@ pub fn polyhedron_polyhedron_coherent(
     let forward = canonical(a, b);
     let (order, first, second) = if forward { (Order::Forward, a, b) } else { (Order::Swapped, b, a) };
     let warm = warm_normal.map(|n| if forward { *n } else { -n });
-    let cached = (mode == Mode::Coherent && features.order == order).then_some(*features);
+    let cached = (mode == Mode::Coherent && features.order == order).then_some(features.kept);
     let (contact, apart, stats, kept) = solve_polyhedra(first, second, warm.as_ref(), last_gap, cached, mode, rule);
-    *features = kept.map_or(Features::default(), |(a, b)| Features { a, b, order });
+    *features = match kept {
+        Kept::None => Features::default(),
+        kept => Features { kept, order },
+    };
     let flip = |c: ContactGeometry| if forward { c } else { ContactGeometry { normal: -c.normal, ..c } };
     let apart = Apart { direction: if forward { apart.direction } else { -apart.direction }, ..apart };
     (contact.map(flip), apart, stats)
@@ -169,23 +172,21 @@ fn canonical(a: &PolyhedronPose, b: &PolyhedronPose) -> bool {
     true
 }
 
-type Kept = ([u16; 4], [u16; 4]);
-
 fn solve_polyhedra(
     a: &PolyhedronPose,
     b: &PolyhedronPose,
     warm_normal: Option<&V3>,
     last_gap: f64,
-    cached: Option<Features>,
+    cached: Option<Kept>,
     mode: Mode,
     rule: ContactPoint,
-) -> (Option<ContactGeometry>, Apart, PolyhedronStats, Option<Kept>) {
+) -> (Option<ContactGeometry>, Apart, PolyhedronStats, Kept) {
     let mut stats = PolyhedronStats::default();
     let d = *b.center() - *a.center();
     let reach = a.bounding_radius() + b.bounding_radius();
     let distance = d.norm();
     if distance >= reach {
-        return (None, Apart { gap: distance - reach, direction: d / distance }, stats, None);
+        return (None, Apart { gap: distance - reach, direction: d / distance }, stats, Kept::None);
     }
     let tiny = TOUCHING * reach;
     let (polytope_gap, visible) = (GAP_POLYTOPE * reach, VISIBLE * reach);
@@ -193,7 +194,11 @@ fn solve_polyhedra(
     let start = warm.or_else(|| unit(&d)).unwrap_or_else(V3::z);
     let mut far = None;
     let mut end = None;
-    let mut cso = match cached.map(|f| warm_tetrahedron(a, b, &d, &f)) {
+    let from_features = match cached {
+        Some(Kept::Contact { a: fa, b: fb }) => Some(warm_tetrahedron(a, b, &d, &fa, &fb)),
+        _ => None,
+    };
+    let mut cso = match from_features {
         Some((tetrahedron, apex)) => {
             let p = &tetrahedron[0];
             let mut cso = Cso::warm(a, b, &start, p.vertex_a, p.vertex_b);
@@ -211,25 +216,30 @@ fn solve_polyhedra(
             cso
         }
         None => {
-            let mut cso = Cso::new(a, b, &start);
+            let mut cso = match cached {
+                Some(Kept::Apart { a: fa, b: fb, .. }) => Cso::warm(a, b, &start, u32::from(fa[0]), u32::from(fb[0])),
+                _ => Cso::new(a, b, &start),
+            };
             if mode == Mode::Coherent && last_gap > 0.0 && warm.is_some() {
                 // n·d − h_A(n) − h_B(−n) = −h_K(n) bounds the distance for any unit n; along the
                 // last separating direction it stays close to the distance while the pair moves
                 // little, so a pair that is still clearly apart costs this one query, and one
                 // still apart along it needs no overlap test before its distance is sought.
+                // Kept along it, the pair keeps its last feature of K for GJK's next start.
                 let first = cso.support(&start);
                 let gap = -start.dot(&first.w);
                 let apart = if gap >= KEPT_GAP * last_gap {
-                    Some(Apart { gap, direction: start })
+                    let kept = match cached {
+                        Some(kept @ Kept::Apart { .. }) => kept,
+                        _ => kept_apart(&[first]),
+                    };
+                    Some((Apart { gap, direction: start }, kept))
                 } else {
-                    (gap > tiny).then(|| {
-                        let (gap, direction) = gjk::separation_from(&mut cso, &start, first, tiny);
-                        Apart { gap, direction }
-                    })
+                    (gap > tiny).then(|| separation_again(&mut cso, &start, first, cached, tiny))
                 };
-                if let Some(apart) = apart {
+                if let Some((apart, kept)) = apart {
                     stats.support_queries = cso.queries;
-                    return (None, apart, stats, None);
+                    return (None, apart, stats, kept);
                 }
             }
             cso
@@ -240,21 +250,21 @@ fn solve_polyhedra(
             Ok(simplex) => gjk::complete(&mut cso, simplex, tiny)
                 .and_then(|s| epa::expand(&mut cso, &s.p, polytope_gap, visible, tiny, &mut stats.epa_iterations)),
             Err(u) => {
-                let apart = if mode == Mode::Coherent && u != V3::zeros() {
-                    let (gap, direction) = gjk::separation(&mut cso, &u, tiny);
-                    Apart { gap, direction }
+                let (apart, kept) = if mode == Mode::Coherent && u != V3::zeros() {
+                    let s = gjk::separation(&mut cso, &u, tiny);
+                    (Apart { gap: s.gap, direction: s.direction }, kept_apart(&s.simplex.p[..s.simplex.len]))
                 } else {
-                    Apart { gap: 0.0, direction: u }
+                    (Apart { gap: 0.0, direction: u }, Kept::None)
                 };
                 stats.support_queries = cso.queries;
-                return (None, apart, stats, None);
+                return (None, apart, stats, kept);
             }
         };
     }
     stats.converged = end.is_some_and(|e| e.converged);
     let Some(end) = end.as_ref().filter(|e| e.depth > 0.0) else {
         stats.support_queries = cso.queries;
-        return (None, Apart::default(), stats, None);
+        return (None, Apart::default(), stats, Kept::None);
     };
     let apex = far.unwrap_or_else(|| {
         let p = cso.support(&-end.normal);
@@ -276,7 +286,7 @@ fn solve_polyhedra(
 }
 
 /// The vertices to keep of EPA's last face and a far point of K, if they fit in 16 bits.
-fn features_of(end: &Penetration, apex: (u32, u32)) -> Option<Kept> {
+fn features_of(end: &Penetration, apex: (u32, u32)) -> Kept {
     let a = [end.face[0].vertex_a, end.face[1].vertex_a, end.face[2].vertex_a, apex.0];
     let b = [end.face[0].vertex_b, end.face[1].vertex_b, end.face[2].vertex_b, apex.1];
     let narrow = |v: [u32; 4]| -> Option<[u16; 4]> {
@@ -286,18 +296,76 @@ fn features_of(end: &Penetration, apex: (u32, u32)) -> Option<Kept> {
         }
         Some(out)
     };
-    Some((narrow(a)?, narrow(b)?))
+    match (narrow(a), narrow(b)) {
+        (Some(a), Some(b)) => Kept::Contact { a, b },
+        _ => Kept::None,
+    }
 }
 
-/// The tetrahedron of K at the current poses on the last step's features (B centred at `d`
-/// from A), with its far point's vertices.
-fn warm_tetrahedron(a: &PolyhedronPose, b: &PolyhedronPose, d: &V3, f: &Features) -> ([Point; 4], (u32, u32)) {
-    let p: [Point; 4] = std::array::from_fn(|k| {
-        let (va, vb) = (u32::from(f.a[k]), u32::from(f.b[k]));
-        let (pa, pb) = (a.vertex(va), b.vertex(vb) + d);
-        Point { w: pa - pb, a: pa, b: pb, vertex_a: va, vertex_b: vb }
-    });
-    (p, (u32::from(f.a[3]), u32::from(f.b[3])))
+/// The distance of a pair found apart again, by GJK from the support point `first` along the
+/// last separating direction `start` and from the feature of K the last distance query ended
+/// on; with the feature to keep. Out of line: the one-query answer is the common case, and it
+/// stays small without GJK's simplices.
+#[inline(never)]
+fn separation_again(
+    cso: &mut Cso<PolyhedronPose, PolyhedronPose>,
+    start: &V3,
+    first: Point,
+    cached: Option<Kept>,
+    tiny: f64,
+) -> (Apart, Kept) {
+    let warm = match cached {
+        Some(Kept::Apart { a: fa, b: fb, len }) => warm_simplex(cso.a, cso.b, &cso.d, &fa, &fb, len),
+        _ => Simplex::default(),
+    };
+    let s = gjk::separation_from(cso, start, first, &warm.p[..warm.len], tiny);
+    (Apart { gap: s.gap, direction: s.direction }, kept_apart(&s.simplex.p[..s.simplex.len]))
+}
+
+/// The vertices to keep of the points of K a pair found apart ended on (one to three: the
+/// feature of K nearest the origin), if they fit in 16 bits.
+fn kept_apart(points: &[Point]) -> Kept {
+    let (mut a, mut b) = ([0u16; 3], [0u16; 3]);
+    if !(1..=3).contains(&points.len()) {
+        return Kept::None;
+    }
+    for (k, p) in points.iter().enumerate() {
+        match (u16::try_from(p.vertex_a), u16::try_from(p.vertex_b)) {
+            (Ok(va), Ok(vb)) => (a[k], b[k]) = (va, vb),
+            _ => return Kept::None,
+        }
+    }
+    Kept::Apart { a, b, len: points.len() as u8 }
+}
+
+/// The point of K of vertex `va` of A and `vb` of B at the current poses (B centred at `d` from A).
+#[inline(always)]
+fn point_of(a: &PolyhedronPose, b: &PolyhedronPose, d: &V3, va: u16, vb: u16) -> Point {
+    let (va, vb) = (u32::from(va), u32::from(vb));
+    let (pa, pb) = (a.vertex(va), b.vertex(vb) + d);
+    Point { w: pa - pb, a: pa, b: pb, vertex_a: va, vertex_b: vb }
+}
+
+/// The points of K at the current poses on the last distance query's feature.
+fn warm_simplex(a: &PolyhedronPose, b: &PolyhedronPose, d: &V3, fa: &[u16; 3], fb: &[u16; 3], len: u8) -> Simplex {
+    let mut simplex = Simplex::default();
+    for k in 0..usize::from(len) {
+        simplex.push(point_of(a, b, d, fa[k], fb[k]));
+    }
+    simplex
+}
+
+/// The tetrahedron of K at the current poses on the last step's features, with its far point's
+/// vertices.
+fn warm_tetrahedron(
+    a: &PolyhedronPose,
+    b: &PolyhedronPose,
+    d: &V3,
+    fa: &[u16; 4],
+    fb: &[u16; 4],
+) -> ([Point; 4], (u32, u32)) {
+    let p: [Point; 4] = std::array::from_fn(|k| point_of(a, b, d, fa[k], fb[k]));
+    (p, (u32::from(fa[3]), u32::from(fb[3])))
 }
 
 /// Whether the tetrahedron holds the origin strictly inside (then EPA may start from it).
@@ -594,8 +662,8 @@ fn penetration<A: Convex, B: Convex>(a: &A, b: &B, warm_normal: Option<&V3>, gap
         Ok(simplex) => simplex,
         Err(u) if u == V3::zeros() => return Err(Apart::default()),
         Err(u) => {
-            let (gap, direction) = gjk::separation(&mut cso, &u, tiny);
-            return Err(Apart { gap, direction });
+            let s = gjk::separation(&mut cso, &u, tiny);
+            return Err(Apart { gap: s.gap, direction: s.direction });
         }
     };
     let end = gjk::complete(&mut cso, simplex, tiny)
