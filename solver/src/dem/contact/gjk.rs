@@ -40,6 +40,11 @@ pub(super) struct Simplex {
 }
 
 impl Simplex {
+    /// The points it holds.
+    pub fn points(&self) -> &[Point] {
+        &self.p[..self.len]
+    }
+
     pub fn push(&mut self, p: Point) {
         self.p[self.len] = p;
         self.len += 1;
@@ -269,7 +274,7 @@ pub(super) fn separation_from<A: Convex, B: Convex>(
     let mut simplex = Simplex::default();
     simplex.push(first);
     for p in warm {
-        if !simplex.p[..simplex.len].iter().any(|q| (q.vertex_a, q.vertex_b) == (p.vertex_a, p.vertex_b)) {
+        if !simplex.points().iter().any(|q| (q.vertex_a, q.vertex_b) == (p.vertex_a, p.vertex_b)) {
             simplex.push(*p);
         }
     }

@@ -251,8 +251,7 @@ fn solve_polyhedra(
                 .and_then(|s| epa::expand(&mut cso, &s.p, polytope_gap, visible, tiny, &mut stats.epa_iterations)),
             Err(u) => {
                 let (apart, kept) = if mode == Mode::Coherent && u != V3::zeros() {
-                    let s = gjk::separation(&mut cso, &u, tiny);
-                    (Apart { gap: s.gap, direction: s.direction }, kept_apart(&s.simplex.p[..s.simplex.len]))
+                    found_apart(&gjk::separation(&mut cso, &u, tiny))
                 } else {
                     (Apart { gap: 0.0, direction: u }, Kept::None)
                 };
@@ -318,8 +317,12 @@ fn separation_again(
         Some(Kept::Apart { a: fa, b: fb, len }) => warm_simplex(cso.a, cso.b, &cso.d, &fa, &fb, len),
         _ => Simplex::default(),
     };
-    let s = gjk::separation_from(cso, start, first, &warm.p[..warm.len], tiny);
-    (Apart { gap: s.gap, direction: s.direction }, kept_apart(&s.simplex.p[..s.simplex.len]))
+    found_apart(&gjk::separation_from(cso, start, first, warm.points(), tiny))
+}
+
+/// A distance bound GJK found, with the feature of K it ended on to keep.
+fn found_apart(s: &gjk::Separation) -> (Apart, Kept) {
+    (Apart { gap: s.gap, direction: s.direction }, kept_apart(s.simplex.points()))
 }
 
 /// The vertices to keep of the points of K a pair found apart ended on (one to three: the
