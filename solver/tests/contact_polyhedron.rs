@@ -10,7 +10,7 @@
 
 mod common;
 
-use common::box_mesh;
+use common::{box_mesh, rhine_mesh_path};
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 use parry3d_f64::math::{Pose, Rotation as PRotation, Vector as PVector};
 use parry3d_f64::query::details::contact_support_map_support_map;
@@ -28,7 +28,7 @@ use solver::dem::contact::polyhedron::{
 use solver::dem::contact::{ContactGeometry, ContactPoint};
 use solver::dem::shape::ConvexPolyhedron;
 use solver::dem::uniform_rotation;
-use solver::grain::TriMesh;
+use solver::grain::{TriMesh, simplify};
 
 type V3 = Vector3<f64>;
 
@@ -462,43 +462,119 @@ fn cylinder_wall() {
     assert!(polyhedron_cylinder_wall(&inside, 0.0, 0.0, radius).is_none());
 }
 
-#[test]
-fn the_cylinder_wall_finds_every_contact_a_scan_of_all_vertices_finds() {
-    // Grains near the wall, many within their bounding sphere's reach of it but not touching
-    // (where the wall query may answer without a scan): contact or not, and the depth, must be
-    // those of the farthest vertex from the axis, found here by scanning every vertex.
-    let mut rng = ChaCha8Rng::seed_from_u64(11);
-    let radius = 5.0;
+/// Grains near the wall of radius `radius` about (1, −2), many within their bounding sphere's
+/// reach of it but not touching (where the wall query may answer without looking at vertices):
+/// contact or not, the depth, and the vertex of the paper's point must be those of the vertex
+/// farthest from the axis, found here by scanning every vertex. Returns (contacts, near but apart).
+fn check_cylinder_wall_against_a_scan(
+    shape: &ConvexPolyhedron,
+    radius: f64,
+    draws: usize,
+    rng: &mut ChaCha8Rng,
+) -> (usize, usize) {
+    let axis = V3::new(1.0, -2.0, 0.0);
     let (mut contacts, mut near_but_apart) = (0, 0);
-    for _ in 0..4000 {
-        let shape = random_hull(&mut rng, 60);
-        let rotation = random_rotation(&mut rng);
+    for _ in 0..draws {
+        let rotation = random_rotation(rng);
         let rho = shape.bounding_radius();
         let phi = rng.random_range(0.0..std::f64::consts::TAU);
         let o = radius - rho * rng.random_range(0.25..1.6);
-        let center = V3::new(1.0 + o * phi.cos(), -2.0 + o * phi.sin(), rng.random_range(0.0..3.0));
-        let pose = PolyhedronPose::new(&shape, center, &rotation);
-        let farthest = (0..shape.vertices().len() as u32)
-            .map(|v| (center + pose.vertex(v) - V3::new(1.0, -2.0, 0.0)).xy().norm())
-            .fold(0.0, f64::max);
-        match polyhedron_cylinder_wall(&pose, 1.0, -2.0, radius) {
-            Some(c) => {
+        let center = axis + V3::new(o * phi.cos(), o * phi.sin(), rng.random_range(0.0..3.0));
+        let pose = PolyhedronPose::new(shape, center, &rotation);
+        let from_axis = |x: V3| (x - axis).xy().norm();
+        let farthest =
+            (0..shape.vertices().len() as u32).map(|v| from_axis(center + pose.vertex(v))).fold(0.0, f64::max);
+        match (
+            polyhedron_cylinder_wall(&pose, axis.x, axis.y, radius),
+            polyhedron_cylinder_wall_witness(&pose, axis.x, axis.y, radius),
+        ) {
+            (Some(c), Some(w)) => {
                 contacts += 1;
-                assert!(
-                    (c.depth - (farthest - radius)).abs() <= 1e-14 * radius,
-                    "{} vs {}",
-                    c.depth,
-                    farthest - radius
-                );
+                let tolerance = 1e-14 * radius;
+                assert!((c.depth - (farthest - radius)).abs() <= tolerance, "{} vs {}", c.depth, farthest - radius);
+                assert_eq!(w.depth, c.depth);
+                // The paper's point is its vertex moved back half the depth: that vertex is a farthest one.
+                let vertex = w.point + w.normal * (0.5 * w.depth);
+                assert!((from_axis(vertex) - farthest).abs() <= tolerance, "{} vs {farthest}", from_axis(vertex));
             }
-            None => {
+            (None, None) => {
                 assert!(farthest <= radius, "missed a contact {:e} deep", farthest - radius);
                 near_but_apart += usize::from(o + rho > radius);
             }
+            (c, w) => panic!("the two contact points disagree on contact: {c:?}, {w:?}"),
         }
+    }
+    (contacts, near_but_apart)
+}
+
+#[test]
+fn the_cylinder_wall_finds_every_contact_a_scan_of_all_vertices_finds() {
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    // Random hulls of 60 points against a wall only 5 times their size: a sharply curved wall.
+    let (mut contacts, mut near_but_apart) = (0, 0);
+    for _ in 0..4000 {
+        let shape = random_hull(&mut rng, 60);
+        let (c, n) = check_cylinder_wall_against_a_scan(&shape, 5.0, 1, &mut rng);
+        contacts += c;
+        near_but_apart += n;
     }
     // Both answers are well represented (about 1,550 and 650 of the 4,000 draws here).
     assert!(contacts > 1000 && near_but_apart > 400, "{contacts} contacts, {near_but_apart} near but apart");
+    // The two Rhine scans at 300 faces (flat facets, many vertices near the support plane), in
+    // a wall 12 times their bounding radius, as in the laboratory cylinder.
+    for k in 0..2 {
+        let mesh = simplify(&TriMesh::from_file(&rhine_mesh_path(k)).unwrap(), 300).unwrap().mesh;
+        let com = mesh.mass_properties().center_of_mass;
+        let shape = ConvexPolyhedron::new(&mesh.map_vertices(|v| v - com)).unwrap();
+        let (contacts, near_but_apart) =
+            check_cylinder_wall_against_a_scan(&shape, 12.0 * shape.bounding_radius(), 2000, &mut rng);
+        assert!(
+            contacts > 500 && near_but_apart > 200,
+            "scan {k}: {contacts} contacts, {near_but_apart} near but apart"
+        );
+    }
+}
+
+#[test]
+fn a_face_flat_on_the_cylinder_wall_touches_it_at_the_last_of_its_equally_far_corners() {
+    // A cube's face parallel to the wall's tangent plane: centred on the radial, four corners
+    // are exactly equally far from the axis; moved along the wall, the two of a vertical edge.
+    // The vertex kept is the last of them by index, as a scan of every vertex in order keeps
+    // it, so that any way of finding it gives one packing.
+    let h = 0.5;
+    let cube = cuboid(2.0 * h, 2.0 * h, 2.0 * h);
+    let radius = 10.0;
+    // The cube in each of its 24 turns (signed permutations, written exactly: a rounded sine
+    // would break the tie), at each of four quarter turns around the axis: the face against the
+    // wall, and with it which corners tie, changes.
+    let mut turns = Vec::new();
+    for (i, j, k) in [(0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)] {
+        for signs in 0..8 {
+            let sign = |bit: usize| if signs >> bit & 1 == 1 { -1.0 } else { 1.0 };
+            let mut m = Matrix3::zeros();
+            (m[(0, i)], m[(1, j)], m[(2, k)]) = (sign(0), sign(1), sign(2));
+            if m.determinant() > 0.0 {
+                turns.push(m);
+            }
+        }
+    }
+    assert_eq!(turns.len(), 24);
+    for (c, s) in [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)] {
+        let (out, across) = (V3::new(c, s, 0.0), V3::new(-s, c, 0.0));
+        for (along, tied) in [(0.0, 4), (0.25, 2), (-0.25, 2)] {
+            let center = out * (radius - h + 1e-3) + across * along + V3::z() * 2.0;
+            for turn in &turns {
+                let pose = PolyhedronPose::new(&cube, center, turn);
+                let far = |v: u32| (center + pose.vertex(v)).xy().norm_squared();
+                let farthest = (0..8).map(far).fold(0.0, f64::max);
+                let ties: Vec<u32> = (0..8).filter(|&v| far(v) == farthest).collect();
+                assert_eq!(ties.len(), tied, "{out} {along} {turn}: {ties:?}");
+                let w = polyhedron_cylinder_wall_witness(&pose, 0.0, 0.0, radius).unwrap();
+                let last = center + pose.vertex(*ties.last().unwrap());
+                assert_close(&(w.point + w.normal * (0.5 * w.depth)), &last, 1e-13, "the last corner");
+            }
+        }
+    }
 }
 
 #[test]
