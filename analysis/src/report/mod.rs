@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 use solver::fabric::Imbrication;
-use solver::grain::{DrawnClass, graded, mass_shares};
+use solver::grain::{DrawnClass, graded, mass_shares, trimmed};
 use thiserror::Error;
 
 use crate::campaign::{Analysis, PACKINGS_PER_FEATURE, Support};
@@ -432,12 +432,6 @@ fn size_classes_section(blocks: &mut Vec<Block>, records: &[JobRecord]) {
     }
     blocks.push(Block::Paragraph(text));
     blocks.push(Block::Table { header, rows });
-}
-
-/// A number with at most two decimals and no trailing zeros: "21", "12.5".
-fn trimmed(x: f64) -> String {
-    let text = format!("{x:.2}");
-    text.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
 /// Table 6: runs of the same setup (parameters apart from the seed) against the measurement.

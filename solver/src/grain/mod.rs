@@ -31,6 +31,6 @@ pub use library::{MeshLibrary, folder_meshes, rhine_meshes};
 pub use mesh::{MassProperties, MeshDefect, MeshError, TriMesh};
 pub use simplify::{Simplified, SimplifyError, simplify};
 pub use size::{
-    DrawnClass, SieveCurve, SizeError, SizeSampler, TABLE3, TABLE3_SIEVES, Table3Case, graded, mass_shares,
+    DrawnClass, SieveCurve, SizeError, SizeSampler, TABLE3, TABLE3_SIEVES, Table3Case, graded, mass_shares, trimmed,
 };
 pub use unit_mesh::UnitMesh;

@@ -258,9 +258,14 @@ pub fn mass_shares(classes: &[DrawnClass]) -> Vec<f64> {
 impl DrawnClass {
     /// "5.6–8 mm", as the sieves are named.
     pub fn label(&self) -> String {
-        let mm = |x: f64| format!("{:.2}", 1e3 * x).trim_end_matches('0').trim_end_matches('.').to_string();
-        format!("{}–{} mm", mm(self.lower), mm(self.upper))
+        format!("{}–{} mm", trimmed(1e3 * self.lower), trimmed(1e3 * self.upper))
     }
+}
+
+/// A number with at most two decimals and no trailing zeros: "21", "12.5", "5.6".
+pub fn trimmed(x: f64) -> String {
+    let text = format!("{x:.2}");
+    text.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
 /// Draws grain sizes: a class by its number weight, then ln D uniform inside the class, which
