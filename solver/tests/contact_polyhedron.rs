@@ -523,9 +523,7 @@ fn the_cylinder_wall_finds_every_contact_a_scan_of_all_vertices_finds() {
     // The two Rhine scans at 300 faces (flat facets, many vertices near the support plane), in
     // a wall 12 times their bounding radius, as in the laboratory cylinder.
     for k in 0..2 {
-        let mesh = simplify(&TriMesh::from_file(&rhine_mesh_path(k)).unwrap(), 300).unwrap().mesh;
-        let com = mesh.mass_properties().center_of_mass;
-        let shape = ConvexPolyhedron::new(&mesh.map_vertices(|v| v - com)).unwrap();
+        let shape = hull(simplify(&TriMesh::from_file(&rhine_mesh_path(k)).unwrap(), 300).unwrap().mesh.vertices());
         let (contacts, near_but_apart) =
             check_cylinder_wall_against_a_scan(&shape, 12.0 * shape.bounding_radius(), 2000, &mut rng);
         assert!(
