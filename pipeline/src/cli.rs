@@ -38,8 +38,12 @@ pub enum Command {
     Cancel(CancelArgs),
     /// Jobs per state, failures, time spent and left.
     Status(StatusArgs),
-    /// One CSV row per job: parameters, porosity and grain statistics.
+    /// One CSV row per job (parameters, porosity and grain statistics), or the done jobs whole
+    /// for `sedpack import`.
     Export(ExportArgs),
+    /// Take the done jobs of files written by `sedpack export --format jsonl` into a database
+    /// (created if missing), e.g. to report over seeds run on several machines.
+    Import(ImportArgs),
     /// Fit and cross-validate porosity models on a campaign and write the report.
     Report(ReportArgs),
     /// Particle-steps per second of the DEM engine on standard settled beds, per shape, thread
@@ -277,7 +281,11 @@ pub struct StatusArgs {
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum ExportFormat {
+    /// One row per job: parameters, porosity and grain statistics.
     Csv,
+    /// The campaign and its done jobs whole, one JSON object per line: what `sedpack import`
+    /// takes into another database.
+    Jsonl,
 }
 
 #[derive(Debug, Args)]
@@ -290,6 +298,15 @@ pub struct ExportArgs {
     /// Output file (default: standard output).
     #[arg(long)]
     pub out: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct ImportArgs {
+    /// Files written by `sedpack export --format jsonl`; each is taken in whole or not at all.
+    #[arg(required = true)]
+    pub files: Vec<PathBuf>,
+    #[arg(long, default_value = DEFAULT_DB)]
+    pub db: PathBuf,
 }
 
 #[derive(Debug, Args)]

@@ -35,6 +35,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Cancel(args) => commands::campaign::cancel(&args),
         Command::Status(args) => commands::campaign::status(&args),
         Command::Export(args) => commands::campaign::export(&args),
+        Command::Import(args) => commands::archive::import(&args),
         Command::Report(args) => commands::report::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
         Command::Settle(args) => commands::settle::run(&args),

@@ -376,6 +376,15 @@ fn a_killed_runner_resumes_from_its_checkpoint_with_identical_results() {
     assert_eq!(field("jobs_not_estimated"), f64::from(not_estimated), "{status}");
     assert!(text.contains("time left"), "{text}");
 
+    // The killed runner's job, picked alone by --only, counts as pending: its runner is dead.
+    let killed = all.iter().find(|r| r.job_id == running[0]).unwrap();
+    let only_friction = format!("material.friction={}", killed.parameters["material.friction"]);
+    let only_seed = format!("seed={}", killed.seed);
+    let alone = ok(&["resume", "killed", "--db", db, "--quiet", "--only", &only_friction, "--only", &only_seed]);
+    assert!(
+        alone.contains("--only picks 1 job(s), 1 of them pending") && alone.contains("1 job(s) finished now"),
+        "{alone}"
+    );
     let resumed = ok(&["resume", "killed", "--db", db, "--quiet"]);
     assert!(resumed.contains("4 done"), "{resumed}");
     let text = ok(&["status", "killed", "--db", db]);

@@ -24,8 +24,8 @@ use sqlx::sqlite::{
 
 pub use error::StoreError;
 pub use types::{
-    Campaign, CampaignStatus, Checkpoint, ClaimedJob, ExportRow, Failure, GrainStatistic, JobResult, JobState, NewJob,
-    Progress, RunningJob, Stage, StoredJob,
+    ArchivedJob, Campaign, CampaignStatus, Checkpoint, ClaimedJob, ExportRow, Failure, GrainStatistic, Imported,
+    JobResult, JobState, NewJob, Progress, RunningJob, Stage, StoredJob,
 };
 
 /// How long a statement waits for another connection's lock before it fails.
@@ -116,24 +116,18 @@ impl Store {
         let now = now();
         let mut added = 0;
         for job in jobs {
-            let inserted = sqlx::query(sql::INSERT_JOB)
-                .bind(&job.id)
-                .bind(campaign_id)
-                .bind(job.format)
-                .bind(self.encode_json(&job.spec, &format!("spec of job {}", job.id))?)
-                .bind(self.to_sql_int(job.seed, &format!("seed of job {}", job.id))?)
-                .bind(self.encode_json(&job.parameters, &format!("parameters of job {}", job.id))?)
-                .bind(job.experiment_porosity)
-                .bind(job.experiment_std)
-                .bind(now)
-                .bind(job.fluid.as_ref().map(|f| self.encode_json(f, &format!("fluid of job {}", job.id))).transpose()?)
+            let inserted = self
+                .bind_job(sql::INSERT_JOB, job, campaign_id, now)?
                 .execute(&mut *tx)
                 .await
                 .map_err(self.db())?
                 .rows_affected();
             if inserted == 0 {
-                let owner: String =
-                    sqlx::query_scalar(sql::JOB_CAMPAIGN).bind(&job.id).fetch_one(&mut *tx).await.map_err(self.db())?;
+                let (owner, _state): (String, String) = sqlx::query_as(sql::JOB_CAMPAIGN_STATE)
+                    .bind(&job.id)
+                    .fetch_one(&mut *tx)
+                    .await
+                    .map_err(self.db())?;
                 if owner != campaign {
                     return Err(self.invalid(format!(
                         "job {} already belongs to campaign {owner:?}, not {campaign:?}: job ids \
@@ -329,19 +323,6 @@ impl Store {
         result: &JobResult,
         statistics: &[GrainStatistic],
     ) -> Result<(), StoreError> {
-        let profile = self.encode_json(&result.profile, &format!("profile of job {job_id}"))?;
-        let particles = self.to_sql_int(result.particles, &format!("particles of job {job_id}"))?;
-        let steps = self.to_sql_int(result.steps, &format!("steps of job {job_id}"))?;
-        let imbrication = result
-            .imbrication
-            .as_ref()
-            .map(|i| self.encode_json(i, &format!("imbrication of job {job_id}")))
-            .transpose()?;
-        let size_classes = result
-            .size_classes
-            .as_ref()
-            .map(|c| self.encode_json(c, &format!("size classes of job {job_id}")))
-            .transpose()?;
         let now = now();
         let mut tx = self.pool.begin_with(sql::BEGIN_IMMEDIATE).await.map_err(self.db())?;
         let finished = sqlx::query(sql::FINISH_JOB)
@@ -356,6 +337,33 @@ impl Store {
         if finished != 1 {
             return Err(self.not_owner(job_id, worker_id));
         }
+        self.insert_result(&mut tx, job_id, result, statistics, now).await?;
+        tx.commit().await.map_err(self.db())
+    }
+
+    /// Stores a done job's result and grain statistics and drops its checkpoint, in the caller's
+    /// transaction.
+    async fn insert_result(
+        &self,
+        conn: &mut SqliteConnection,
+        job_id: &str,
+        result: &JobResult,
+        statistics: &[GrainStatistic],
+        now: f64,
+    ) -> Result<(), StoreError> {
+        let profile = self.encode_json(&result.profile, &format!("profile of job {job_id}"))?;
+        let particles = self.to_sql_int(result.particles, &format!("particles of job {job_id}"))?;
+        let steps = self.to_sql_int(result.steps, &format!("steps of job {job_id}"))?;
+        let imbrication = result
+            .imbrication
+            .as_ref()
+            .map(|i| self.encode_json(i, &format!("imbrication of job {job_id}")))
+            .transpose()?;
+        let size_classes = result
+            .size_classes
+            .as_ref()
+            .map(|c| self.encode_json(c, &format!("size classes of job {job_id}")))
+            .transpose()?;
         sqlx::query(sql::INSERT_RESULT)
             .bind(job_id)
             .bind(result.porosity)
@@ -370,7 +378,7 @@ impl Store {
             .bind(now)
             .bind(imbrication)
             .bind(size_classes)
-            .execute(&mut *tx)
+            .execute(&mut *conn)
             .await
             .map_err(self.db())?;
         for statistic in statistics {
@@ -379,12 +387,12 @@ impl Store {
                 .bind(&statistic.name)
                 .bind(statistic.mean)
                 .bind(statistic.std)
-                .execute(&mut *tx)
+                .execute(&mut *conn)
                 .await
                 .map_err(self.db())?;
         }
-        sqlx::query(sql::DELETE_CHECKPOINT).bind(job_id).execute(&mut *tx).await.map_err(self.db())?;
-        tx.commit().await.map_err(self.db())
+        sqlx::query(sql::DELETE_CHECKPOINT).bind(job_id).execute(&mut *conn).await.map_err(self.db())?;
+        Ok(())
     }
 
     /// Marks the job failed with its error text and drops its checkpoint, so that a retry starts
@@ -572,20 +580,180 @@ impl Store {
     /// from one snapshot.
     pub async fn export(&self, campaign: &str) -> Result<Vec<ExportRow>, StoreError> {
         type JobRow = (String, String, u64, u32, Option<String>, String, Option<f64>, Option<f64>, Option<String>);
-        type ResultRow = (String, f64, f64, f64, String, u64, f64, u64, f64, String, Option<String>, Option<String>);
         let mut tx = self.pool.begin().await.map_err(self.db())?;
         let campaign_id = self.campaign_id(&mut tx, campaign).await?;
         let jobs: Vec<JobRow> =
             sqlx::query_as(sql::EXPORT_JOBS).bind(campaign_id).fetch_all(&mut *tx).await.map_err(self.db())?;
-        let results: Vec<ResultRow> =
-            sqlx::query_as(sql::EXPORT_RESULTS).bind(campaign_id).fetch_all(&mut *tx).await.map_err(self.db())?;
-        let statistics: Vec<(String, String, f64, f64)> = sqlx::query_as(sql::EXPORT_GRAIN_STATISTICS)
-            .bind(campaign_id)
-            .fetch_all(&mut *tx)
+        let (mut results, mut statistics) = self.results_of(&mut tx, campaign_id).await?;
+        tx.commit().await.map_err(self.db())?;
+        jobs.into_iter()
+            .map(|(job_id, state, seed, attempts, error, parameters, experiment_porosity, experiment_std, fluid)| {
+                Ok(ExportRow {
+                    state: self.state(&job_id, &state)?,
+                    seed,
+                    attempts,
+                    error,
+                    parameters: self.decode_json(&parameters, &format!("parameters of job {job_id}"))?,
+                    experiment_porosity,
+                    experiment_std,
+                    fluid: fluid.map(|f| self.decode_json(&f, &format!("fluid of job {job_id}"))).transpose()?,
+                    result: results.remove(&job_id),
+                    grain_statistics: statistics.remove(&job_id).unwrap_or_default(),
+                    job_id,
+                })
+            })
+            .collect()
+    }
+
+    /// The campaign's done jobs in submission order, whole, from one snapshot: what
+    /// [`Store::import`] takes into another database.
+    pub async fn archive(&self, campaign: &str) -> Result<Vec<ArchivedJob>, StoreError> {
+        type JobRow = (
+            String,
+            u32,
+            String,
+            u64,
+            String,
+            Option<f64>,
+            Option<f64>,
+            Option<String>,
+            Option<String>,
+            u32,
+            Option<f64>,
+            Option<f64>,
+        );
+        let mut tx = self.pool.begin().await.map_err(self.db())?;
+        let campaign_id = self.campaign_id(&mut tx, campaign).await?;
+        let jobs: Vec<JobRow> =
+            sqlx::query_as(sql::ARCHIVE_JOBS).bind(campaign_id).fetch_all(&mut *tx).await.map_err(self.db())?;
+        let (mut results, mut statistics) = self.results_of(&mut tx, campaign_id).await?;
+        tx.commit().await.map_err(self.db())?;
+        jobs.into_iter()
+            .map(|row| {
+                let (
+                    id,
+                    format,
+                    spec,
+                    seed,
+                    parameters,
+                    experiment_porosity,
+                    experiment_std,
+                    fluid,
+                    worker_id,
+                    attempts,
+                    started_at,
+                    finished_at,
+                ) = row;
+                let result =
+                    results.remove(&id).ok_or_else(|| self.invalid(format!("job {id} is done but has no result")))?;
+                Ok(ArchivedJob {
+                    job: NewJob {
+                        format,
+                        spec: self.decode_json(&spec, &format!("spec of job {id}"))?,
+                        seed,
+                        parameters: self.decode_json(&parameters, &format!("parameters of job {id}"))?,
+                        experiment_porosity,
+                        experiment_std,
+                        fluid: fluid.map(|f| self.decode_json(&f, &format!("fluid of job {id}"))).transpose()?,
+                        id: id.clone(),
+                    },
+                    worker_id,
+                    attempts,
+                    started_at,
+                    finished_at,
+                    result,
+                    grain_statistics: statistics.remove(&id).unwrap_or_default(),
+                })
+            })
+            .collect()
+    }
+
+    /// Takes done jobs of another database into this one, all or nothing: the campaign is
+    /// created with `spec` if this database has none of that name (else its spec is kept); a job
+    /// it lacks is added done, one it has pending or failed is completed with the imported result,
+    /// one it has done keeps its own result, and one a worker runs is left to it. A job id that
+    /// belongs to another campaign is an error and nothing is imported.
+    pub async fn import(&self, campaign: &str, spec: &str, jobs: &[ArchivedJob]) -> Result<Imported, StoreError> {
+        let now = now();
+        let mut tx = self.pool.begin_with(sql::BEGIN_IMMEDIATE).await.map_err(self.db())?;
+        sqlx::query(sql::INSERT_CAMPAIGN_IF_NEW)
+            .bind(campaign)
+            .bind(spec)
+            .bind(now)
+            .execute(&mut *tx)
             .await
             .map_err(self.db())?;
+        let campaign_id = self.campaign_id(&mut tx, campaign).await?;
+        let mut imported = Imported::default();
+        for archived in jobs {
+            let job = &archived.job;
+            let stored: Option<(String, String)> = sqlx::query_as(sql::JOB_CAMPAIGN_STATE)
+                .bind(&job.id)
+                .fetch_optional(&mut *tx)
+                .await
+                .map_err(self.db())?;
+            match stored {
+                Some((owner, _)) if owner != campaign => {
+                    return Err(self.invalid(format!(
+                        "job {} already belongs to campaign {owner:?}, not {campaign:?}: job ids must be unique \
+                         across campaigns",
+                        job.id
+                    )));
+                }
+                Some((_, state)) => match self.state(&job.id, &state)? {
+                    JobState::Done => {
+                        imported.kept += 1;
+                        continue;
+                    }
+                    JobState::Running => {
+                        imported.running.push(job.id.clone());
+                        continue;
+                    }
+                    JobState::Pending | JobState::Failed => {
+                        sqlx::query(sql::COMPLETE_IMPORTED)
+                            .bind(&job.id)
+                            .bind(&archived.worker_id)
+                            .bind(archived.attempts)
+                            .bind(archived.started_at)
+                            .bind(archived.finished_at)
+                            .execute(&mut *tx)
+                            .await
+                            .map_err(self.db())?;
+                        imported.completed += 1;
+                    }
+                },
+                None => {
+                    self.bind_job(sql::INSERT_DONE_JOB, job, campaign_id, now)?
+                        .bind(&archived.worker_id)
+                        .bind(archived.attempts)
+                        .bind(archived.started_at)
+                        .bind(archived.finished_at)
+                        .execute(&mut *tx)
+                        .await
+                        .map_err(self.db())?;
+                    imported.added += 1;
+                }
+            }
+            self.insert_result(&mut tx, &job.id, &archived.result, &archived.grain_statistics, now).await?;
+        }
         tx.commit().await.map_err(self.db())?;
+        Ok(imported)
+    }
 
+    /// The results and grain statistics of the campaign's jobs, by job id.
+    async fn results_of(
+        &self,
+        conn: &mut SqliteConnection,
+        campaign_id: i64,
+    ) -> Result<(HashMap<String, JobResult>, HashMap<String, Vec<GrainStatistic>>), StoreError> {
+        type ResultRow = (String, f64, f64, f64, String, u64, f64, u64, f64, String, Option<String>, Option<String>);
+        let results: Vec<ResultRow> =
+            sqlx::query_as(sql::EXPORT_RESULTS).bind(campaign_id).fetch_all(&mut *conn).await.map_err(self.db())?;
+        let statistics: Vec<(String, String, f64, f64)> = sqlx::query_as(sql::EXPORT_GRAIN_STATISTICS)
+            .bind(campaign_id)
+            .fetch_all(&mut *conn)
+            .await
+            .map_err(self.db())?;
         let mut results_by_job = HashMap::new();
         for (
             job_id,
@@ -626,23 +794,7 @@ impl Store {
         for (job_id, name, mean, std) in statistics {
             statistics_by_job.entry(job_id).or_default().push(GrainStatistic { name, mean, std });
         }
-        jobs.into_iter()
-            .map(|(job_id, state, seed, attempts, error, parameters, experiment_porosity, experiment_std, fluid)| {
-                Ok(ExportRow {
-                    state: self.state(&job_id, &state)?,
-                    seed,
-                    attempts,
-                    error,
-                    parameters: self.decode_json(&parameters, &format!("parameters of job {job_id}"))?,
-                    experiment_porosity,
-                    experiment_std,
-                    fluid: fluid.map(|f| self.decode_json(&f, &format!("fluid of job {job_id}"))).transpose()?,
-                    result: results_by_job.remove(&job_id),
-                    grain_statistics: statistics_by_job.remove(&job_id).unwrap_or_default(),
-                    job_id,
-                })
-            })
-            .collect()
+        Ok((results_by_job, statistics_by_job))
     }
 
     async fn campaign_id(&self, conn: &mut SqliteConnection, name: &str) -> Result<i64, StoreError> {
@@ -669,6 +821,29 @@ impl Store {
         }
         let updated = query.execute(executor).await.map_err(self.db())?.rows_affected();
         if updated == 1 { Ok(()) } else { Err(self.not_owner(job_id, worker_id)) }
+    }
+
+    /// The statement with ?1 to ?10 bound to the job as submitted, as [`sql::INSERT_JOB`] and
+    /// [`sql::INSERT_DONE_JOB`] take it.
+    fn bind_job<'q>(
+        &self,
+        statement: &'static str,
+        job: &'q NewJob,
+        campaign_id: i64,
+        now: f64,
+    ) -> Result<sqlx::query::Query<'q, sqlx::Sqlite, sqlx::sqlite::SqliteArguments>, StoreError> {
+        let what = |field: &str| format!("{field} of job {}", job.id);
+        Ok(sqlx::query(statement)
+            .bind(&job.id)
+            .bind(campaign_id)
+            .bind(job.format)
+            .bind(self.encode_json(&job.spec, &what("spec"))?)
+            .bind(self.to_sql_int(job.seed, &what("seed"))?)
+            .bind(self.encode_json(&job.parameters, &what("parameters"))?)
+            .bind(job.experiment_porosity)
+            .bind(job.experiment_std)
+            .bind(now)
+            .bind(job.fluid.as_ref().map(|f| self.encode_json(f, &what("fluid"))).transpose()?))
     }
 
     /// Runs one statement on the pool; gives how many rows it changed.

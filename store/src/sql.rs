@@ -12,6 +12,9 @@ pub const BEGIN_IMMEDIATE: &str = "BEGIN IMMEDIATE";
 pub const UPSERT_CAMPAIGN: &str = "
     INSERT INTO campaigns (name, spec, created_at, updated_at) VALUES (?1, ?2, ?3, ?3)
     ON CONFLICT (name) DO UPDATE SET spec = excluded.spec, updated_at = excluded.updated_at";
+pub const INSERT_CAMPAIGN_IF_NEW: &str = "
+    INSERT INTO campaigns (name, spec, created_at, updated_at) VALUES (?1, ?2, ?3, ?3)
+    ON CONFLICT (name) DO NOTHING";
 pub const CAMPAIGN_ID: &str = "SELECT id FROM campaigns WHERE name = ?1";
 pub const CAMPAIGN: &str = "SELECT name, spec, executor, created_at, updated_at FROM campaigns WHERE name = ?1";
 pub const CAMPAIGNS: &str =
@@ -24,8 +27,18 @@ pub const INSERT_JOB: &str = "
                       created_at, fluid)
     VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10)
     ON CONFLICT (id) DO NOTHING";
-pub const JOB_CAMPAIGN: &str = "
-    SELECT campaigns.name FROM jobs JOIN campaigns ON campaigns.id = jobs.campaign_id
+pub const INSERT_DONE_JOB: &str = "
+    INSERT INTO jobs (id, campaign_id, format, spec, seed, parameters, experiment_porosity, experiment_std,
+                      created_at, fluid, state, worker_id, attempts, started_at, finished_at, heartbeat_at,
+                      wall_time)
+    VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, 'done', ?11, ?12, ?13, ?14, ?14, ?14 - ?13)";
+pub const COMPLETE_IMPORTED: &str = "
+    UPDATE jobs
+    SET state = 'done', error = NULL, worker_id = ?2, attempts = attempts + ?3, started_at = ?4,
+        finished_at = ?5, heartbeat_at = ?5, wall_time = ?5 - ?4
+    WHERE id = ?1 AND state IN ('pending', 'failed')";
+pub const JOB_CAMPAIGN_STATE: &str = "
+    SELECT campaigns.name, jobs.state FROM jobs JOIN campaigns ON campaigns.id = jobs.campaign_id
     WHERE jobs.id = ?1";
 pub const CLAIM_JOB: &str = "
     UPDATE jobs
@@ -130,6 +143,10 @@ pub const FAILURES: &str = "
 pub const EXPORT_JOBS: &str = "
     SELECT id, state, seed, attempts, error, parameters, experiment_porosity, experiment_std, fluid FROM jobs
     WHERE campaign_id = ?1 ORDER BY rowid";
+pub const ARCHIVE_JOBS: &str = "
+    SELECT id, format, spec, seed, parameters, experiment_porosity, experiment_std, fluid,
+           worker_id, attempts, started_at, finished_at
+    FROM jobs WHERE campaign_id = ?1 AND state = 'done' ORDER BY rowid";
 pub const EXPORT_RESULTS: &str = "
     SELECT results.job_id, porosity, z_minus, z_plus, profile, particles, simulated_time, steps,
            results.wall_time, solver_version, imbrication, size_classes

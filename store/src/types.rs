@@ -208,3 +208,33 @@ pub struct ExportRow {
     pub result: Option<JobResult>,
     pub grain_statistics: Vec<GrainStatistic>,
 }
+
+/// A done job as one database hands it to another (`sedpack export --format jsonl`, `sedpack
+/// import`): the job as submitted, its last attempt and its result.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ArchivedJob {
+    #[serde(flatten)]
+    pub job: NewJob,
+    /// Who ran it last, how many times it was claimed, and when its last attempt started and
+    /// ended (UNIX seconds of the machine that ran it).
+    pub worker_id: Option<String>,
+    pub attempts: u32,
+    pub started_at: Option<f64>,
+    pub finished_at: Option<f64>,
+    pub result: JobResult,
+    pub grain_statistics: Vec<GrainStatistic>,
+}
+
+/// What [`crate::Store::import`] did with the jobs it was given.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Imported {
+    /// Jobs the database did not have, added done.
+    pub added: u64,
+    /// Jobs the database had pending or failed, now done with the imported result (their
+    /// checkpoints dropped).
+    pub completed: u64,
+    /// Jobs the database had done already: their stored results are kept.
+    pub kept: u64,
+    /// Jobs a worker of the database is running: left to it.
+    pub running: Vec<String>,
+}

@@ -15,7 +15,8 @@ use store::{CampaignStatus, ExportRow, JobState, NewJob, Progress, Store, StoreE
 use tracing::info;
 
 use crate::campaign::{Campaign, read_campaign};
-use crate::cli::{CancelArgs, ContinueArgs, ExportArgs, LocalArgs, ResumeArgs, RunArgs, StatusArgs};
+use crate::cli::{CancelArgs, ContinueArgs, ExportArgs, ExportFormat, LocalArgs, ResumeArgs, RunArgs, StatusArgs};
+use crate::commands::archive;
 use crate::executor::{Executor, Request};
 use crate::output::{Table, phase_words, print_json};
 use crate::records::new_job;
@@ -267,6 +268,8 @@ async fn continue_campaign(
             let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
             let (workers, threads) = local_threads(local, cores)?;
             retry_failed(store, name, common.retry_failed).await?;
+            // Jobs of dead runners are pending again before `--only` counts the pending ones.
+            runner::recover(store, name).await?;
             let only = selected(store, name, &common.only).await?;
             let options = RunOptions {
                 workers,
@@ -277,7 +280,6 @@ async fn continue_campaign(
             };
             if !common.discard_old_checkpoints {
                 // All at once before anything starts; the workers check jobs requeued later.
-                runner::recover(store, name).await?;
                 let mut old = runner::old_checkpoints(store, name).await?;
                 old.retain(|c| only.as_ref().is_none_or(|ids| ids.contains(&c.job)));
                 refuse_old_checkpoints(name, &old)?;
@@ -703,18 +705,29 @@ fn progress_text(p: &Progress, now: f64) -> String {
 }
 
 pub fn export(args: &ExportArgs) -> anyhow::Result<()> {
-    let rows = runtime()?.block_on(async {
+    let export = runtime()?.block_on(async {
         let store = open_existing(&args.db).await?;
         catch_up(&store, &args.db, &args.name).await?;
-        Ok::<_, anyhow::Error>(store.export(&args.name).await?)
+        Ok::<_, anyhow::Error>(match args.format {
+            ExportFormat::Csv => Export::Csv(store.export(&args.name).await?),
+            ExportFormat::Jsonl => Export::Jsonl(store.campaign(&args.name).await?, store.archive(&args.name).await?),
+        })
     })?;
     let mut out: Box<dyn Write> = match &args.out {
         Some(path) => Box::new(std::fs::File::create(path).with_context(|| format!("{}", path.display()))?),
         None => Box::new(std::io::stdout().lock()),
     };
-    write_csv(&mut out, &rows)?;
+    match export {
+        Export::Csv(rows) => write_csv(&mut out, &rows)?,
+        Export::Jsonl(campaign, jobs) => archive::write(&mut out, &campaign, &jobs)?,
+    }
     out.flush()?;
     Ok(())
+}
+
+enum Export {
+    Csv(Vec<ExportRow>),
+    Jsonl(store::Campaign, Vec<store::ArchivedJob>),
 }
 
 /// One row per job: id, state, seed, the grid keys, the result and the grain statistics.

@@ -1,5 +1,6 @@
 //! One module per command of the command line.
 
+pub mod archive;
 pub mod bench;
 pub mod campaign;
 pub mod forms;
