@@ -725,6 +725,7 @@ pub fn export(args: &ExportArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// What `export` writes: every job's row, or the campaign and its done jobs whole.
 enum Export {
     Csv(Vec<ExportRow>),
     Jsonl(store::Campaign, Vec<store::ArchivedJob>),
