@@ -710,12 +710,7 @@ impl Store {
                         continue;
                     }
                     JobState::Pending | JobState::Failed => {
-                        sqlx::query(sql::COMPLETE_IMPORTED)
-                            .bind(&job.id)
-                            .bind(&archived.worker_id)
-                            .bind(archived.attempts)
-                            .bind(archived.started_at)
-                            .bind(archived.finished_at)
+                        bind_attempt(sqlx::query(sql::COMPLETE_IMPORTED).bind(&job.id), archived)
                             .execute(&mut *tx)
                             .await
                             .map_err(self.db())?;
@@ -723,11 +718,7 @@ impl Store {
                     }
                 },
                 None => {
-                    self.bind_job(sql::INSERT_DONE_JOB, job, campaign_id, now)?
-                        .bind(&archived.worker_id)
-                        .bind(archived.attempts)
-                        .bind(archived.started_at)
-                        .bind(archived.finished_at)
+                    bind_attempt(self.bind_job(sql::INSERT_DONE_JOB, job, campaign_id, now)?, archived)
                         .execute(&mut *tx)
                         .await
                         .map_err(self.db())?;
@@ -887,6 +878,15 @@ impl Store {
         i64::try_from(value)
             .map_err(|_| self.invalid(format!("{what} = {value} exceeds 2^63 - 1, the largest SQLite integer")))
     }
+}
+
+/// The query with its next four parameters bound to the archived job's last attempt: who ran
+/// it, how many times it was claimed, when it started and ended.
+fn bind_attempt<'q>(
+    query: sqlx::query::Query<'q, sqlx::Sqlite, sqlx::sqlite::SqliteArguments>,
+    archived: &'q ArchivedJob,
+) -> sqlx::query::Query<'q, sqlx::Sqlite, sqlx::sqlite::SqliteArguments> {
+    query.bind(&archived.worker_id).bind(archived.attempts).bind(archived.started_at).bind(archived.finished_at)
 }
 
 /// name, spec, executor, created_at, updated_at
