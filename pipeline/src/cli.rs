@@ -290,6 +290,7 @@ pub enum ExportFormat {
 
 #[derive(Debug, Args)]
 pub struct ExportArgs {
+    /// The campaign's name.
     pub name: String,
     #[arg(long, default_value = DEFAULT_DB)]
     pub db: PathBuf,
