@@ -117,10 +117,10 @@ fn tasks(db: &str, name: &str) -> Vec<Value> {
     json(&["status", name, "--db", db, "--json"])["tasks"].as_array().unwrap().clone()
 }
 
-/// A task (`ARRAY_INDEX`) that Slurm runs now for one of `jobs` and that started less than a
-/// second ago (so it is far from done), with its job.
-fn fresh_task(db: &str, name: &str, jobs: &[String]) -> (String, String) {
-    until(120, "a task that has just started", || {
+/// A task (`ARRAY_INDEX`) that Slurm runs now for one of `jobs` and that started less than
+/// `seconds` ago (a second: so it is far from done), with its job.
+fn task_started_within(seconds: f64, db: &str, name: &str, jobs: &[String]) -> (String, String) {
+    until(120, "a task that started within the time", || {
         tasks(db, name).iter().find_map(|t| {
             let (task, job) = (t["task"].as_str()?, t["job_id"].as_str()?);
             if t["slurm_state"] != "RUNNING" || !jobs.iter().any(|j| j == job) {
@@ -130,7 +130,7 @@ fn fresh_task(db: &str, name: &str, jobs: &[String]) -> (String, String) {
                 events(db, name, job).iter().rev().find(|e| e["task"] == task && e["kind"] == "started")?["at"]
                     .as_f64()?;
             let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap().as_secs_f64();
-            (now - started < 1.0).then(|| (task.to_string(), job.to_string()))
+            (now - started < seconds).then(|| (task.to_string(), job.to_string()))
         })
     })
 }
@@ -272,7 +272,7 @@ fn killed_submitters_scancel_requeue_and_preemption_lose_nothing_and_run_nothing
     }
 
     // 3. A running task cancelled with scancel: its job fails, saying so, checkpoint kept.
-    let (cancelled_task, cancelled_job) = fresh_task(db, "chaos", &long);
+    let (cancelled_task, cancelled_job) = task_started_within(1.0, db, "chaos", &long);
     shell(&format!("scancel {cancelled_task}"));
     let failure = until(90, "the cancelled job to fail", || {
         let status = json(&["status", "chaos", "--db", db, "--json"]);
@@ -287,11 +287,11 @@ fn killed_submitters_scancel_requeue_and_preemption_lose_nothing_and_run_nothing
 
     // 4. A running task requeued, 5. running tasks preempted by a job of the urgent partition
     // that needs the whole node; both run again from their checkpoint.
-    let (requeued, _) = fresh_task(db, "chaos", &long);
+    let (requeued, _) = task_started_within(1.0, db, "chaos", &long);
     shell(&format!("scontrol requeue {requeued}"));
     until(30, "the requeue", || shell(&format!("squeue -h -j {requeued} -o %T")).trim().eq("PENDING").then_some(()));
     release_requeued();
-    fresh_task(db, "chaos", &long);
+    task_started_within(1.0, db, "chaos", &long);
     let urgent = shell("sbatch --parsable --partition=urgent --cpus-per-task=2 --output=/dev/null --wrap 'sleep 2'");
     until(60, "the urgent job", || {
         shell(&format!("squeue -h -t all -j {} -o %T", urgent.trim())).trim().eq("COMPLETED").then_some(())
@@ -342,10 +342,7 @@ fn a_task_told_its_time_limit_is_near_continues_bit_for_bit() {
     // --batch` sends it the same way, now rather than at Slurm's next 30 s limit check (the
     // ignored test below waits for the real limit).
     let job = rows(db, "near").remove(0).job_id;
-    let task = until(120, "the task to start", || {
-        let task = tasks(db, "near").into_iter().find(|t| t["slurm_state"] == "RUNNING")?["task"].as_str()?.to_string();
-        events(db, "near", &job).iter().any(|e| e["task"] == task.as_str() && e["kind"] == "started").then_some(task)
-    });
+    let (task, _) = task_started_within(f64::INFINITY, db, "near", &[job]);
     shell(&format!("scancel --batch --signal=USR1 {task}"));
     let out = ok(&["resume", "near", "--db", db, "--wait", "--quiet"]);
     assert!(out.contains("near: 1 done"), "{out}");
